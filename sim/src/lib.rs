@@ -1,0 +1,1 @@
+//! Simulations that stand in for hardware in tests, CI and the demo.

@@ -1,0 +1,1 @@
+//! dressform: personalized symmetric mannequins from 3D body scans.
