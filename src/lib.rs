@@ -1,1 +1,13 @@
-//! dressform: personalized symmetric mannequins from 3D body scans.
+//! dressform: personalized symmetric mannequins from 3D body scans (Hu et al., "Personalized
+//! 3D Mannequin Reconstruction Based on 3D Scanning"), and the robotic dress form they drive.
+//!
+//! Modules follow the pipeline:
+//! - [`mesh`]: the one triangle-mesh type, its topology and components;
+//! - [`scan`]: reading OBJ/PLY/STL, validation and cleaning, the canonical body frame;
+//! - [`report`]: what `dressform info` says about a scan;
+//! - [`output`]: atomic file writes.
+
+pub mod mesh;
+pub mod output;
+pub mod report;
+pub mod scan;

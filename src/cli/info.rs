@@ -1,0 +1,31 @@
+//! `dressform info <scan> [--json]`.
+
+use super::{Failure, FrameArgs};
+use dressform::report::ScanInfo;
+use dressform::scan;
+use std::path::PathBuf;
+
+#[derive(Debug, clap::Args)]
+pub struct InfoArgs {
+    /// The scan: an .obj, .ply or .stl file.
+    scan: PathBuf,
+    /// Print the report as JSON (documented in the README).
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    frame: FrameArgs,
+}
+
+pub fn run(args: &InfoArgs) -> Result<(), Failure> {
+    let scan = scan::load(&args.scan, &args.frame.options()).map_err(Failure::bad_input)?;
+    let info = ScanInfo::new(&scan);
+    for w in &info.warnings {
+        eprintln!("warning: {}: {w}", info.file);
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&info).map_err(Failure::other)?);
+    } else {
+        print!("{info}");
+    }
+    Ok(())
+}

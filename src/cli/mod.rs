@@ -1,0 +1,70 @@
+//! Command-line arguments and dispatch. Each command lives in its own module.
+
+mod demo;
+mod info;
+
+use clap::{Parser, Subcommand};
+use dressform::scan::frame::{Direction, FrameOptions, Units};
+
+/// Personalized symmetric mannequins from 3D body scans, and the robotic dress form they drive.
+#[derive(Debug, Parser)]
+#[command(name = "dressform", version, about)]
+pub struct Args {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Describe a scan: counts, units, up axis, facing, height, components, holes, manifoldness.
+    Info(info::InfoArgs),
+    /// Run the pipeline on a built-in synthetic customer, no files or hardware needed.
+    Demo(demo::DemoArgs),
+}
+
+/// How the scan's frame is given on the command line (all optional: detected by default).
+#[derive(Debug, Clone, clap::Args)]
+pub struct FrameArgs {
+    /// The scan's length unit [default: detected from the body's height].
+    #[arg(long, value_enum)]
+    units: Option<Units>,
+    /// The scan's up axis: x, y, z, -x, -y or -z [default: detected].
+    #[arg(long, allow_hyphen_values = true)]
+    up: Option<Direction>,
+    /// The axis the subject faces in the scan: x, y, z, -x, -y or -z [default: detected].
+    #[arg(long, allow_hyphen_values = true)]
+    facing: Option<Direction>,
+}
+
+impl FrameArgs {
+    fn options(&self) -> FrameOptions {
+        FrameOptions { units: self.units, up: self.up, facing: self.facing }
+    }
+}
+
+/// A command that failed: the message to print and the process exit code.
+#[derive(Debug)]
+pub struct Failure {
+    pub message: String,
+    pub exit_code: u8,
+}
+
+impl Failure {
+    /// Input the user gave is unusable: exit status 2.
+    fn bad_input(e: impl std::fmt::Display) -> Self {
+        Failure { message: e.to_string(), exit_code: 2 }
+    }
+
+    /// Anything else (an output that cannot be written, ...): exit status 1.
+    fn other(e: impl std::fmt::Display) -> Self {
+        Failure { message: e.to_string(), exit_code: 1 }
+    }
+}
+
+/// Runs the command `args` names.
+pub fn run(args: Args) -> Result<(), Failure> {
+    match args.command {
+        Command::Info(a) => info::run(&a),
+        Command::Demo(a) => demo::run(&a),
+    }
+}

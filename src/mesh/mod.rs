@@ -1,0 +1,131 @@
+//! The one triangle-mesh type of the pipeline, and queries on it.
+//!
+//! A [`Mesh`] is an indexed triangle list in `f64`. Readers produce it, the canonical frame
+//! moves it, slicing and symmetry read it, writers store it.
+
+mod components;
+mod topology;
+mod weld;
+
+pub use components::{Component, components};
+pub use topology::{Topology, topology};
+
+use glam::DVec3;
+
+/// An indexed triangle mesh. Triangles are counter-clockwise seen from outside.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<DVec3>,
+    /// Triangles as indices into `positions`.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// An axis-aligned bounding box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    /// Smallest coordinate on each axis.
+    pub min: DVec3,
+    /// Largest coordinate on each axis.
+    pub max: DVec3,
+}
+
+impl Aabb {
+    /// The box around `points`, or `None` when there are none.
+    pub fn around(points: impl IntoIterator<Item = DVec3>) -> Option<Self> {
+        let mut it = points.into_iter();
+        let first = it.next()?;
+        Some(it.fold(Aabb { min: first, max: first }, |b, p| Aabb {
+            min: b.min.min(p),
+            max: b.max.max(p),
+        }))
+    }
+
+    /// Edge lengths of the box.
+    pub fn size(&self) -> DVec3 {
+        self.max - self.min
+    }
+}
+
+impl Mesh {
+    /// A mesh from positions and triangles (indices are not checked here; readers check them).
+    pub fn new(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Self {
+        Mesh { positions, triangles }
+    }
+
+    /// The three corners of triangle `t`.
+    pub fn corners(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|i| self.positions[i as usize])
+    }
+
+    /// Area-weighted normal of triangle `t` (length = twice the area).
+    pub fn scaled_normal(&self, t: usize) -> DVec3 {
+        let [a, b, c] = self.corners(t);
+        (b - a).cross(c - a)
+    }
+
+    /// Area of triangle `t`.
+    pub fn triangle_area(&self, t: usize) -> f64 {
+        0.5 * self.scaled_normal(t).length()
+    }
+
+    /// Total surface area.
+    pub fn area(&self) -> f64 {
+        (0..self.triangles.len()).map(|t| self.triangle_area(t)).sum()
+    }
+
+    /// Bounding box of the vertices used by triangles, or `None` for a mesh without triangles.
+    pub fn bounds(&self) -> Option<Aabb> {
+        Aabb::around(self.triangles.iter().flatten().map(|&i| self.positions[i as usize]))
+    }
+
+    /// Signed volume enclosed (positive for a closed, outward-oriented mesh).
+    pub fn signed_volume(&self) -> f64 {
+        (0..self.triangles.len())
+            .map(|t| {
+                let [a, b, c] = self.corners(t);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
+    /// The same mesh with every position mapped by `f`.
+    pub fn map_positions(&self, f: impl Fn(DVec3) -> DVec3) -> Mesh {
+        Mesh {
+            positions: self.positions.iter().map(|&p| f(p)).collect(),
+            triangles: self.triangles.clone(),
+        }
+    }
+
+    /// Keeps only the triangles for which `keep` is true, then drops unused vertices.
+    pub fn retain_triangles(&mut self, mut keep: impl FnMut(usize) -> bool) {
+        let mut t = 0;
+        self.triangles.retain(|_| {
+            t += 1;
+            keep(t - 1)
+        });
+        self.drop_unused_vertices();
+    }
+
+    /// Removes vertices no triangle refers to, renumbering the triangles.
+    pub fn drop_unused_vertices(&mut self) {
+        let mut new_index = vec![u32::MAX; self.positions.len()];
+        let mut positions = Vec::with_capacity(self.positions.len());
+        for tri in &mut self.triangles {
+            for i in tri.iter_mut() {
+                let slot = &mut new_index[*i as usize];
+                if *slot == u32::MAX {
+                    *slot = positions.len() as u32;
+                    positions.push(self.positions[*i as usize]);
+                }
+                *i = *slot;
+            }
+        }
+        self.positions = positions;
+    }
+
+    /// Merges vertices with bit-identical positions; returns how many were merged away.
+    pub fn weld_identical(&mut self) -> usize {
+        weld::weld_identical(self)
+    }
+}

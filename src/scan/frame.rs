@@ -1,0 +1,303 @@
+//! The canonical body frame: millimetres, Z up, floor at z = 0, +X = the subject's left, the
+//! subject facing -Y (right-handed, as in Blender's front view), origin under the torso's
+//! centre. Scans arrive in any unit, with Y or Z up and turned any way about the vertical; this
+//! module finds out which, and keeps the transform so outputs can go back to the scan's frame.
+//!
+//! Detection, each step overridable:
+//! - **up**: the axis of the largest extent (a standing body is taller than wide or deep); its
+//!   sign from the area-weighted centroid, which sits above mid-height (torso, arms and head
+//!   carry more surface than the legs);
+//! - **units**: from the height — a standing person is 0.5-2.5 m tall, and that range in m,
+//!   dm, cm and mm does not overlap;
+//! - **left-right axis**: the major principal axis of the surface between hips and shoulders
+//!   (shoulders, hips and hanging arms are wider than the body is deep); exact for a
+//!   mirror-symmetric body, whatever its turn;
+//! - **front**: the side the feet point to (the lowest 4% of the body lies in front of the
+//!   shins).
+
+use crate::mesh::Mesh;
+use glam::{DMat3, DVec2, DVec3};
+use serde::Serialize;
+use std::fmt;
+use std::str::FromStr;
+
+/// A length unit a scan may be stored in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Units {
+    /// Metres.
+    M,
+    /// Decimetres (MakeHuman).
+    Dm,
+    /// Centimetres.
+    Cm,
+    /// Millimetres.
+    Mm,
+}
+
+impl Units {
+    /// Millimetres in one unit.
+    pub fn mm(self) -> f64 {
+        match self {
+            Units::M => 1000.0,
+            Units::Dm => 100.0,
+            Units::Cm => 10.0,
+            Units::Mm => 1.0,
+        }
+    }
+
+    /// The unit in which `height` is the height of a standing person (0.5-2.5 m).
+    pub fn from_height(height: f64) -> Option<Units> {
+        [Units::M, Units::Dm, Units::Cm, Units::Mm]
+            .into_iter()
+            .find(|u| (500.0..=2500.0).contains(&(height * u.mm())))
+    }
+}
+
+impl fmt::Display for Units {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Units::M => "m",
+            Units::Dm => "dm",
+            Units::Cm => "cm",
+            Units::Mm => "mm",
+        })
+    }
+}
+
+/// A signed coordinate axis of the scan's frame: `+x`, `-y`, `z` (= `+z`), ...
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Direction {
+    axis: usize,
+    negative: bool,
+}
+
+impl Direction {
+    /// The unit vector.
+    pub fn vector(self) -> DVec3 {
+        let mut v = DVec3::ZERO;
+        v[self.axis] = if self.negative { -1.0 } else { 1.0 };
+        v
+    }
+
+    /// The signed axis that `v` points along, if it is within 1 degree of one.
+    pub fn nearest(v: DVec3) -> Option<Direction> {
+        let axis = v.abs().max_position();
+        let d = Direction { axis, negative: v[axis] < 0.0 };
+        (d.vector().dot(v.normalize_or_zero()) > 1.0f64.to_radians().cos()).then_some(d)
+    }
+}
+
+impl FromStr for Direction {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let lower = s.to_ascii_lowercase();
+        let (negative, name) = match lower.as_bytes() {
+            [b'-', rest @ ..] => (true, rest),
+            [b'+', rest @ ..] => (false, rest),
+            rest => (false, rest),
+        };
+        let axis = match name {
+            b"x" => 0,
+            b"y" => 1,
+            b"z" => 2,
+            _ => return Err(format!("'{s}' is not an axis: use x, y, z, -x, -y or -z")),
+        };
+        Ok(Direction { axis, negative })
+    }
+}
+
+impl fmt::Display for Direction {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}{}", if self.negative { '-' } else { '+' }, ["x", "y", "z"][self.axis])
+    }
+}
+
+impl Serialize for Direction {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+/// What the user says about the scan's frame; `None` means "detect it".
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FrameOptions {
+    /// The scan's length unit.
+    pub units: Option<Units>,
+    /// The scan's up direction.
+    pub up: Option<Direction>,
+    /// The direction the subject faces, in the scan's frame.
+    pub facing: Option<Direction>,
+}
+
+/// Why the canonical frame could not be established.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FrameError {
+    /// The height matches no unit for a person.
+    #[error(
+        "the body is {height:.4} units tall along {up}, which is 0.5-2.5 m in none of m, dm, cm, mm; \
+         pass --units (and check --up)"
+    )]
+    UnknownUnits {
+        /// Height in the file's units.
+        height: f64,
+        /// The up direction used.
+        up: Direction,
+    },
+    /// `--facing` along the up axis.
+    #[error("--facing {facing} is not horizontal when up is {up}")]
+    FacingNotHorizontal {
+        /// The facing given.
+        facing: Direction,
+        /// The up direction used.
+        up: Direction,
+    },
+}
+
+/// How a scan's coordinates map to the canonical frame: `canonical = R (s p) + t`.
+#[derive(Debug, Clone, Serialize)]
+pub struct CanonicalFrame {
+    /// The scan's unit.
+    pub units: Units,
+    /// Whether `units` was detected (rather than given).
+    pub units_detected: bool,
+    /// The scan's up direction.
+    pub up: Direction,
+    /// Whether `up` was detected.
+    pub up_detected: bool,
+    /// The direction the subject faces, in the scan's frame (a unit vector).
+    pub facing: DVec3,
+    /// Whether `facing` was detected.
+    pub facing_detected: bool,
+    /// How far (mm) the feet lie in front of the shins: the evidence for the facing.
+    /// Near zero means the front could not be told from the back.
+    pub facing_evidence_mm: f64,
+    /// Height of the body in mm.
+    pub height_mm: f64,
+    #[serde(skip)]
+    rotation: DMat3,
+    #[serde(skip)]
+    translation: DVec3,
+}
+
+impl CanonicalFrame {
+    /// A scan point in the canonical frame.
+    pub fn to_canonical(&self, p: DVec3) -> DVec3 {
+        self.rotation * (p * self.units.mm()) + self.translation
+    }
+
+    /// A canonical point back in the scan's frame.
+    pub fn to_scan(&self, q: DVec3) -> DVec3 {
+        self.rotation.transpose() * (q - self.translation) / self.units.mm()
+    }
+
+    /// `facing` as an axis name when it is one (within 1 degree).
+    pub fn facing_axis(&self) -> Option<Direction> {
+        Direction::nearest(self.facing)
+    }
+}
+
+/// Area-weighted triangle centroids, with heights along the up direction.
+struct Samples {
+    points: Vec<(DVec3, f64)>,
+    up: DVec3,
+    floor: f64,
+    height: f64,
+}
+
+impl Samples {
+    /// Samples whose height lies in `[lo, hi]` (fractions of the body's height).
+    fn band(&self, lo: f64, hi: f64) -> impl Iterator<Item = (DVec3, f64)> + '_ {
+        self.points.iter().copied().filter(move |(p, _)| {
+            let f = (p.dot(self.up) - self.floor) / self.height;
+            (lo..=hi).contains(&f)
+        })
+    }
+}
+
+/// Area-weighted mean of `samples`, or `None` when they carry no area.
+fn mean(samples: impl Iterator<Item = (DVec3, f64)>) -> Option<DVec3> {
+    let (sum, weight) = samples.fold((DVec3::ZERO, 0.0), |(s, w), (p, a)| (s + p * a, w + a));
+    (weight > 0.0).then(|| sum / weight)
+}
+
+/// Finds the canonical frame of `mesh` (a cleaned body), honouring `options`.
+pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, FrameError> {
+    let points: Vec<(DVec3, f64)> = (0..mesh.triangles.len())
+        .map(|t| {
+            let [a, b, c] = mesh.corners(t);
+            ((a + b + c) / 3.0, mesh.triangle_area(t))
+        })
+        .collect();
+    let bounds = mesh.bounds().unwrap_or(crate::mesh::Aabb { min: DVec3::ZERO, max: DVec3::ZERO });
+
+    let up = options.up.unwrap_or_else(|| {
+        let axis = bounds.size().max_position();
+        let centroid = mean(points.iter().copied()).unwrap_or(bounds.min);
+        let mid = 0.5 * (bounds.min[axis] + bounds.max[axis]);
+        Direction { axis, negative: centroid[axis] < mid }
+    });
+    let u = up.vector();
+    let heights = mesh.positions.iter().map(|p| p.dot(u));
+    let (floor, top) =
+        heights.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| (lo.min(h), hi.max(h)));
+    let height = top - floor;
+    let units = match options.units {
+        Some(units) => units,
+        None => Units::from_height(height).ok_or(FrameError::UnknownUnits { height, up })?,
+    };
+    let samples = Samples { points, up: u, floor, height };
+
+    // Horizontal coordinates on the two other axes.
+    let e1 = Direction { axis: (up.axis + 1) % 3, negative: false }.vector();
+    let e2 = Direction { axis: (up.axis + 2) % 3, negative: false }.vector();
+    let flat = |p: DVec3| DVec2::new(p.dot(e1), p.dot(e2));
+    let trunk = || samples.band(0.45, 0.75);
+    let centre = mean(trunk()).unwrap_or(bounds.min);
+    let c2 = flat(centre);
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for (p, a) in trunk() {
+        let d = flat(p) - c2;
+        sxx += a * d.x * d.x;
+        sxy += a * d.x * d.y;
+        syy += a * d.y * d.y;
+    }
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let front_back = DVec2::new(-theta.sin(), theta.cos());
+
+    let feet = mean(samples.band(0.0, 0.04)).map(flat);
+    let shins = mean(samples.band(0.10, 0.25)).map(flat);
+    let evidence = match (feet, shins) {
+        (Some(f), Some(s)) => (f - s).dot(front_back),
+        _ => 0.0,
+    };
+    let (facing, facing_detected) = match options.facing {
+        Some(f) => {
+            if f.axis == up.axis {
+                return Err(FrameError::FacingNotHorizontal { facing: f, up });
+            }
+            (f.vector(), false)
+        }
+        None => {
+            let forward = if evidence >= 0.0 { front_back } else { -front_back };
+            ((e1 * forward.x + e2 * forward.y).normalize(), true)
+        }
+    };
+    let left = u.cross(facing);
+    let rotation = DMat3::from_cols(left, -facing, u).transpose();
+    let scale = units.mm();
+    let c = rotation * (centre * scale);
+    let translation = DVec3::new(-c.x, -c.y, -floor * scale);
+    Ok(CanonicalFrame {
+        units,
+        units_detected: options.units.is_none(),
+        up,
+        up_detected: options.up.is_none(),
+        facing,
+        facing_detected,
+        facing_evidence_mm: evidence.abs() * scale,
+        height_mm: height * scale,
+        rotation,
+        translation,
+    })
+}

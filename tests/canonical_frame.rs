@@ -1,0 +1,117 @@
+//! The canonical frame on the MakeHuman body: units, up axis, height and facing are found in
+//! whatever units, up axis, format and turn the body comes in.
+
+mod common;
+
+use common::{dressform, makehuman};
+use dressform::mesh::Mesh;
+use dressform::output::write_atomically;
+use dressform::scan::format::Format;
+use dressform::scan::{self, frame::FrameOptions};
+use glam::{DMat3, DVec3};
+use std::path::Path;
+
+fn info_json(path: &Path) -> serde_json::Value {
+    let (code, stdout, stderr) = dressform(&["info", "--json", path.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    serde_json::from_str(&stdout).unwrap()
+}
+
+/// The MakeHuman body in the canonical frame (mm, Z up, facing -Y).
+fn canonical_body(dir: &Path) -> Mesh {
+    scan::load(&dir.join("base.obj"), &FrameOptions::default()).unwrap().body
+}
+
+#[test]
+fn makehuman_base_is_decimetres_y_up_1666_mm_facing_plus_z() {
+    let Some(dir) = makehuman() else { return };
+    let info = info_json(&dir.join("base.obj"));
+    assert_eq!(info["frame"]["units"], "dm");
+    assert_eq!(info["frame"]["up"], "+y");
+    assert_eq!(info["frame"]["facing_axis"], "+z");
+    let height = info["body"]["height_mm"].as_f64().unwrap();
+    assert!((height - 1666.0).abs() <= 2.0, "height {height}");
+    assert_eq!(info["body"]["closed"], true);
+    assert_eq!(info["body"]["manifold"], true);
+    // The helper geometry (tights, skirt, eyes, joint cubes...) is not the body.
+    assert!(info["components"]["dropped"].as_array().unwrap().len() > 100);
+}
+
+#[test]
+fn the_same_body_in_other_units_axes_and_formats_has_the_same_height() {
+    let Some(dir) = makehuman() else { return };
+    let body = canonical_body(&dir);
+    let tmp = tempfile::tempdir().unwrap();
+    type ToFile = fn(DVec3) -> DVec3;
+    let variants: [(&str, ToFile, &str, &str); 4] = [
+        ("metres_z_up.obj", |p| p / 1000.0, "m", "+z"),
+        ("mm_y_up.ply", |p| DVec3::new(p.x, p.z, -p.y), "mm", "+y"),
+        ("cm_z_up.stl", |p| p / 10.0, "cm", "+z"),
+        ("m_minus_y_up.ply", |p| DVec3::new(p.x, -p.z, p.y) / 1000.0, "m", "-y"),
+    ];
+    for (name, to_file, units, up) in variants {
+        let path = tmp.path().join(name);
+        let format = Format::from_path(&path).unwrap();
+        write_atomically(&path, &format.encode(&body.map_positions(to_file))).unwrap();
+        let info = info_json(&path);
+        assert_eq!(info["frame"]["units"], units, "{name}");
+        assert_eq!(info["frame"]["up"], up, "{name}");
+        let height = info["body"]["height_mm"].as_f64().unwrap();
+        assert!((height - 1666.0).abs() <= 2.0, "{name}: height {height}");
+    }
+}
+
+#[test]
+fn turned_by_any_angle_about_the_vertical_it_lands_facing_minus_y() {
+    let Some(dir) = makehuman() else { return };
+    let body = canonical_body(&dir);
+    for step in 0..48 {
+        let angle = (step as f64 * 7.5 + 1.3).to_radians();
+        let turn = DMat3::from_rotation_z(angle);
+        let turned = body.map_positions(|p| turn * p + DVec3::new(120.0, -40.0, 0.0));
+        let scan = scan::from_mesh(turned, Path::new("turned"), &FrameOptions::default()).unwrap();
+        let truth = turn * DVec3::NEG_Y;
+        let error = scan.frame.facing.angle_between(truth).to_degrees();
+        assert!(error < 3.0, "turned {:.1} deg: facing off by {error:.2} deg", angle.to_degrees());
+        // And the canonical body is where it was: same height, centred, facing -Y.
+        let b = scan.body.bounds().unwrap();
+        assert!((b.max.z - 1666.0).abs() <= 2.0 && b.min.z.abs() < 1e-9);
+    }
+}
+
+#[test]
+fn canonical_and_scan_frames_round_trip() {
+    let Some(dir) = makehuman() else { return };
+    let scan = scan::load(&dir.join("base.obj"), &FrameOptions::default()).unwrap();
+    for p in [DVec3::new(1.0, 2.0, 3.0), DVec3::new(-4.5, 16.0, 0.2)] {
+        let back = scan.frame.to_scan(scan.frame.to_canonical(p));
+        assert!((back - p).length() < 1e-12);
+    }
+    // MakeHuman's frame: (x, y, z) dm -> (100 x, -100 z, 100 y) mm, up to a shift.
+    let a = scan.frame.to_canonical(DVec3::ZERO);
+    let d = scan.frame.to_canonical(DVec3::new(0.1, 0.2, 0.3)) - a;
+    assert!((d - DVec3::new(10.0, -30.0, 20.0)).length() < 1e-4, "{d}");
+}
+
+#[test]
+fn overrides_win_over_detection() {
+    let Some(dir) = makehuman() else { return };
+    let path = dir.join("base.obj");
+    let (code, stdout, stderr) = dressform(&[
+        "info",
+        "--json",
+        "--units",
+        "cm",
+        "--up",
+        "y",
+        "--facing",
+        "-z",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let info: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(info["frame"]["units"], "cm");
+    assert_eq!(info["frame"]["facing_axis"], "-z");
+    assert_eq!(info["frame"]["facing_detected"], false);
+    assert!((info["body"]["height_mm"].as_f64().unwrap() - 166.6).abs() < 0.2);
+}

@@ -1,0 +1,155 @@
+//! Round trips through every mesh format we read and write, and reading the variants we only
+//! read (ASCII and big-endian PLY, ASCII STL).
+
+use dressform::mesh::Mesh;
+use dressform::scan::format::Format;
+use glam::DVec3;
+use std::fmt::Write as _;
+
+/// An irregular closed mesh (an octahedron with awkward coordinates).
+fn sample() -> Mesh {
+    let p = [
+        [0.1, -0.333_333_333_333_3, 1e-7],
+        [1234.5678, 0.0, 3.0],
+        [-7.25, 9.875, -0.001],
+        [2.0 / 3.0, 1e5, 17.0],
+        [-1.0, -1.0, 1.0 / 7.0],
+        [3.3, 4.4, 5.5],
+    ];
+    let t = vec![
+        [0, 1, 2],
+        [0, 2, 3],
+        [0, 3, 4],
+        [0, 4, 1],
+        [5, 2, 1],
+        [5, 3, 2],
+        [5, 4, 3],
+        [5, 1, 4],
+    ];
+    Mesh::new(p.iter().map(|&a| DVec3::from_array(a)).collect(), t)
+}
+
+/// Corner positions of every triangle, in order: independent of vertex numbering.
+fn corners(mesh: &Mesh) -> Vec<[DVec3; 3]> {
+    (0..mesh.triangles.len()).map(|t| mesh.corners(t)).collect()
+}
+
+#[test]
+fn obj_round_trip_is_exact() {
+    let mesh = sample();
+    let back = Format::Obj.read(&Format::Obj.encode(&mesh)).unwrap();
+    assert_eq!(back, mesh);
+}
+
+#[test]
+fn binary_ply_round_trip_is_exact() {
+    let mesh = sample();
+    let back = Format::Ply.read(&Format::Ply.encode(&mesh)).unwrap();
+    assert_eq!(back, mesh);
+}
+
+#[test]
+fn binary_stl_round_trip_is_exact_in_f32() {
+    let mesh = sample().map_positions(|p| p.as_vec3().as_dvec3());
+    let back = Format::Stl.read(&Format::Stl.encode(&mesh)).unwrap();
+    assert_eq!(corners(&back), corners(&mesh));
+    assert_eq!(back.positions.len(), mesh.positions.len(), "STL corners are welded");
+}
+
+#[test]
+fn binary_stl_whose_header_starts_with_solid_is_read_as_binary() {
+    let mesh = sample().map_positions(|p| p.as_vec3().as_dvec3());
+    let mut bytes = Format::Stl.encode(&mesh);
+    bytes[..12].copy_from_slice(b"solid scan42");
+    assert_eq!(corners(&Format::Stl.read(&bytes).unwrap()), corners(&mesh));
+}
+
+fn ascii_ply(mesh: &Mesh, quads: bool) -> Vec<u8> {
+    let mut s = String::new();
+    let faces = if quads { 1 } else { mesh.triangles.len() };
+    let _ = write!(
+        s,
+        "ply\nformat ascii 1.0\ncomment test\nelement vertex {}\nproperty float x\nproperty float y\n\
+         property float z\nproperty uchar red\nelement face {faces}\nproperty list uchar int vertex_indices\n\
+         end_header\n",
+        mesh.positions.len()
+    );
+    for p in &mesh.positions {
+        let _ = writeln!(s, "{:e} {:e} {:e} 255", p.x as f32, p.y as f32, p.z as f32);
+    }
+    if quads {
+        s.push_str("4 0 1 2 3\n");
+    } else {
+        for t in &mesh.triangles {
+            let _ = writeln!(s, "3 {} {} {}", t[0], t[1], t[2]);
+        }
+    }
+    s.into_bytes()
+}
+
+#[test]
+fn ascii_ply_reads_to_printed_precision() {
+    let mesh = sample();
+    let back = Format::Ply.read(&ascii_ply(&mesh, false)).unwrap();
+    assert_eq!(back.triangles, mesh.triangles);
+    for (a, b) in back.positions.iter().zip(&mesh.positions) {
+        assert!((*a - *b).length() <= 1e-6 * b.length().max(1.0), "{a} vs {b}");
+    }
+}
+
+#[test]
+fn ply_polygons_are_triangulated() {
+    let back = Format::Ply.read(&ascii_ply(&sample(), true)).unwrap();
+    assert_eq!(back.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+}
+
+#[test]
+fn big_endian_ply_reads_exactly() {
+    let mesh = sample();
+    let mut bytes = format!(
+        "ply\nformat binary_big_endian 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
+         property double z\nelement face {}\nproperty list uchar uint vertex_indices\nend_header\n",
+        mesh.positions.len(),
+        mesh.triangles.len()
+    )
+    .into_bytes();
+    for p in &mesh.positions {
+        for c in p.to_array() {
+            bytes.extend(c.to_be_bytes());
+        }
+    }
+    for t in &mesh.triangles {
+        bytes.push(3);
+        for i in t {
+            bytes.extend(i.to_be_bytes());
+        }
+    }
+    assert_eq!(Format::Ply.read(&bytes).unwrap(), mesh);
+}
+
+#[test]
+fn ascii_stl_reads_to_printed_precision() {
+    let mesh = sample();
+    let mut s = String::from("solid test\n");
+    for t in 0..mesh.triangles.len() {
+        s.push_str("facet normal 0 0 0\nouter loop\n");
+        for p in mesh.corners(t) {
+            let _ = writeln!(s, "vertex {:e} {:e} {:e}", p.x as f32, p.y as f32, p.z as f32);
+        }
+        s.push_str("endloop\nendfacet\n");
+    }
+    s.push_str("endsolid test\n");
+    let back = Format::Stl.read(s.as_bytes()).unwrap();
+    for (a, b) in corners(&back).iter().zip(corners(&mesh)) {
+        for k in 0..3 {
+            assert!((a[k] - b[k]).length() <= 1e-6 * b[k].length().max(1.0));
+        }
+    }
+}
+
+#[test]
+fn obj_quads_and_groups_are_read_and_triangulated() {
+    let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\ng a\nf 1 2 3 4\ng b\nf 1 2 5\n";
+    let mesh = Format::Obj.read(text.as_bytes()).unwrap();
+    assert_eq!(mesh.triangles.len(), 3);
+}
