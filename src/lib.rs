@@ -4,6 +4,7 @@
 //! Modules follow the pipeline:
 //! - [`mesh`]: the one triangle-mesh type, its topology and components;
 //! - [`scan`]: reading OBJ/PLY/STL, validation and cleaning, the canonical body frame;
+//! - [`slice`]: horizontal cross-sections and their girths;
 //! - [`report`]: what `dressform info` says about a scan;
 //! - [`output`]: atomic file writes.
 
@@ -11,3 +12,4 @@ pub mod mesh;
 pub mod output;
 pub mod report;
 pub mod scan;
+pub mod slice;

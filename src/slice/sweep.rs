@@ -1,0 +1,252 @@
+//! Cutting a mesh by many horizontal planes at once.
+//!
+//! Each triangle finds the planes it crosses by two binary searches in the sorted heights, so
+//! the work is proportional to the number of crossings, not triangles × planes. A triangle
+//! crossing plane `h` contributes one segment, from the point on its edge that runs down
+//! through `h` to the point on its edge that runs up; for an outward-oriented surface that
+//! makes outer loops counter-clockwise seen from above.
+
+use super::{Contour, Section};
+use crate::mesh::Mesh;
+use glam::{DVec2, DVec3};
+
+/// One triangle's piece of one plane: from `start` on edge `from` to `end` on edge `to`.
+#[derive(Debug, Clone, Copy)]
+struct Segment {
+    from: u64,
+    to: u64,
+    start: DVec2,
+    end: DVec2,
+}
+
+/// Key of the undirected edge between vertices `a` and `b`.
+fn edge_key(a: u32, b: u32) -> u64 {
+    (u64::from(a.min(b)) << 32) | u64::from(a.max(b))
+}
+
+/// Where the edge between vertices `a` and `b` meets height `h`. Computed from the lower
+/// vertex index, so both triangles sharing the edge get the same point.
+fn crossing(mesh: &Mesh, a: u32, b: u32, h: f64) -> DVec2 {
+    let (i, j) = (a.min(b) as usize, a.max(b) as usize);
+    let (p, q): (DVec3, DVec3) = (mesh.positions[i], mesh.positions[j]);
+    let t = (h - p.z) / (q.z - p.z);
+    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    (p + (q - p) * t).truncate()
+}
+
+/// The segment triangle `tri` leaves on the plane at `h` (it must cross it).
+fn segment(mesh: &Mesh, tri: [u32; 3], h: f64) -> Segment {
+    let above = tri.map(|v| mesh.positions[v as usize].z >= h);
+    let (mut down, mut up) = ((0, 0), (0, 0));
+    for k in 0..3 {
+        let (a, b) = (tri[k], tri[(k + 1) % 3]);
+        match (above[k], above[(k + 1) % 3]) {
+            (true, false) => down = (a, b),
+            (false, true) => up = (a, b),
+            _ => {}
+        }
+    }
+    Segment {
+        from: edge_key(down.0, down.1),
+        to: edge_key(up.0, up.1),
+        start: crossing(mesh, down.0, down.1, h),
+        end: crossing(mesh, up.0, up.1, h),
+    }
+}
+
+/// Cross-sections of `mesh` at each of `heights` (any order; returned in the same order).
+pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
+    let mut order: Vec<usize> = (0..heights.len()).collect();
+    order.sort_by(|&a, &b| heights[a].total_cmp(&heights[b]));
+    let sorted: Vec<f64> = order.iter().map(|&i| heights[i]).collect();
+
+    // Planes crossed by each triangle: zmin < h <= zmax (a vertex on the plane counts as above).
+    let ranges: Vec<(usize, usize)> = mesh
+        .triangles
+        .iter()
+        .map(|tri| {
+            let z = tri.map(|v| mesh.positions[v as usize].z);
+            let (lo, hi) = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
+            (sorted.partition_point(|&h| h <= lo), sorted.partition_point(|&h| h <= hi))
+        })
+        .collect();
+    let mut offsets = vec![0usize; sorted.len() + 1];
+    for &(lo, hi) in &ranges {
+        for k in lo..hi {
+            offsets[k + 1] += 1;
+        }
+    }
+    for k in 0..sorted.len() {
+        offsets[k + 1] += offsets[k];
+    }
+    let mut fill = offsets.clone();
+    let placeholder = Segment { from: 0, to: 0, start: DVec2::ZERO, end: DVec2::ZERO };
+    let mut segments = vec![placeholder; offsets[sorted.len()]];
+    for (tri, &(lo, hi)) in mesh.triangles.iter().zip(&ranges) {
+        for k in lo..hi {
+            segments[fill[k]] = segment(mesh, *tri, sorted[k]);
+            fill[k] += 1;
+        }
+    }
+
+    let mut out: Vec<Option<Section>> = vec![None; heights.len()];
+    for (k, &i) in order.iter().enumerate() {
+        let plane = &mut segments[offsets[k]..offsets[k + 1]];
+        out[i] = Some(chain(plane, sorted[k]));
+    }
+    out.into_iter().flatten().collect()
+}
+
+/// Chains one plane's segments into loops, closing open chains by pairing their loose ends.
+fn chain(segments: &mut [Segment], height: f64) -> Section {
+    segments.sort_unstable_by_key(|s| s.from);
+    let next_of = |key: u64, segs: &[Segment]| -> Option<usize> {
+        let i = segs.partition_point(|s| s.from < key);
+        (i < segs.len() && segs[i].from == key).then_some(i)
+    };
+    let mut is_target = vec![false; segments.len()];
+    for s in segments.iter() {
+        if let Some(j) = next_of(s.to, segments) {
+            is_target[j] = true;
+        }
+    }
+    let mut used = vec![false; segments.len()];
+    let mut walk = |first: usize, used: &mut Vec<bool>| -> (Vec<DVec2>, bool) {
+        let mut points = Vec::new();
+        let mut at = first;
+        loop {
+            used[at] = true;
+            points.push(segments[at].start);
+            match next_of(segments[at].to, segments) {
+                Some(j) if j == first => return (points, true),
+                Some(j) if !used[j] => at = j,
+                _ => {
+                    points.push(segments[at].end); // an open chain keeps its last point
+                    return (points, false);
+                }
+            }
+        }
+    };
+    let mut closed = Vec::new();
+    let mut open = Vec::new();
+    // Open chains first, from their heads, so that no chain is entered in the middle.
+    for first in (0..segments.len()).filter(|&i| !is_target[i]) {
+        if !used[first] {
+            open.push(walk(first, &mut used).0);
+        }
+    }
+    for first in 0..segments.len() {
+        if !used[first] {
+            let (points, is_closed) = walk(first, &mut used);
+            if is_closed { closed.push(points) } else { open.push(points) }
+        }
+    }
+    let bridged_gaps = open.len();
+    closed.extend(close_open_chains(open));
+    let mut loops: Vec<Contour> =
+        closed.into_iter().filter(|p| p.len() >= 3).map(|points| Contour { points }).collect();
+    loops.sort_by(|a, b| b.signed_area().abs().total_cmp(&a.signed_area().abs()));
+    Section { height, loops, bridged_gaps }
+}
+
+/// Joins open chains into loops: the end of a chain is joined to the nearest chain start
+/// (its own start closes it). Each join bridges one gap of the scan with a straight edge.
+fn close_open_chains(mut open: Vec<Vec<DVec2>>) -> Vec<Vec<DVec2>> {
+    let mut loops = Vec::new();
+    while let Some(mut chain) = open.pop() {
+        loop {
+            let (Some(&end), Some(&own_start)) = (chain.last(), chain.first()) else { break };
+            let nearest = open
+                .iter()
+                .enumerate()
+                .map(|(i, c)| (i, c[0].distance_squared(end)))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            match nearest {
+                Some((i, d)) if d < own_start.distance_squared(end) => {
+                    let next = open.swap_remove(i);
+                    chain.extend(next);
+                }
+                _ => break,
+            }
+        }
+        loops.push(chain);
+    }
+    loops
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    /// A closed vertical prism over an n-gon of radius r, from z = 0 to z = 10, outward.
+    fn prism(n: usize, r: f64) -> Mesh {
+        let mut p = Vec::new();
+        for z in [0.0, 10.0] {
+            for i in 0..n {
+                let a = 2.0 * PI * i as f64 / n as f64;
+                p.push(DVec3::new(r * a.cos(), r * a.sin(), z));
+            }
+        }
+        p.push(DVec3::new(0.0, 0.0, 0.0));
+        p.push(DVec3::new(0.0, 0.0, 10.0));
+        let n32 = n as u32;
+        let mut t = Vec::new();
+        for i in 0..n32 {
+            let j = (i + 1) % n32;
+            t.push([i, j, n32 + j]);
+            t.push([i, n32 + j, n32 + i]);
+            t.push([2 * n32, j, i]);
+            t.push([2 * n32 + 1, n32 + i, n32 + j]);
+        }
+        Mesh::new(p, t)
+    }
+
+    #[test]
+    fn prism_sections_are_ccw_polygons() {
+        let mesh = prism(64, 50.0);
+        assert!(mesh.signed_volume() > 0.0);
+        let s = sections(&mesh, &[5.0, 2.5, 7.5]);
+        assert_eq!(s.len(), 3);
+        assert_eq!(s[1].height, 2.5);
+        for sec in &s {
+            assert_eq!(sec.loops.len(), 1);
+            assert_eq!(sec.bridged_gaps, 0);
+            let c = &sec.loops[0];
+            assert_eq!(c.points.len(), 128, "a point on every side and every quad diagonal");
+            assert!(c.signed_area() > 0.0, "counter-clockwise from above");
+            let expected = 64.0 * 2.0 * 50.0 * (PI / 64.0).sin();
+            assert!((c.perimeter() - expected).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn planes_through_vertices_still_give_closed_loops() {
+        let mesh = prism(16, 10.0);
+        for h in [0.0, 10.0] {
+            let s = &sections(&mesh, &[h])[0];
+            assert!(s.loops.iter().all(|l| l.points.len() >= 3));
+            assert_eq!(s.bridged_gaps, 0);
+        }
+    }
+
+    #[test]
+    fn planes_outside_give_empty_sections() {
+        let s = sections(&prism(8, 1.0), &[-1.0, 11.0]);
+        assert!(s.iter().all(|s| s.loops.is_empty()));
+    }
+
+    #[test]
+    fn holes_are_bridged_and_reported() {
+        let mut mesh = prism(32, 20.0);
+        // Remove two side quads: a hole crossing the plane at z = 5.
+        mesh.triangles.drain(0..8);
+        let s = &sections(&mesh, &[5.0])[0];
+        assert_eq!(s.loops.len(), 1);
+        assert_eq!(s.bridged_gaps, 1);
+        // The gap is bridged by a chord across the two missing sides.
+        let side = 2.0 * 20.0 * (PI / 32.0).sin();
+        let chord = 2.0 * 20.0 * (2.0 * PI / 32.0).sin();
+        assert!((s.loops[0].perimeter() - (30.0 * side + chord)).abs() < 1e-9);
+    }
+}
