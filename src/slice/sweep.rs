@@ -111,7 +111,7 @@ fn chain(segments: &mut [Segment], height: f64) -> Section {
         }
     }
     let mut used = vec![false; segments.len()];
-    let mut walk = |first: usize, used: &mut Vec<bool>| -> (Vec<DVec2>, bool) {
+    let walk = |first: usize, used: &mut Vec<bool>| -> (Vec<DVec2>, bool) {
         let mut points = Vec::new();
         let mut at = first;
         loop {
@@ -154,8 +154,7 @@ fn chain(segments: &mut [Segment], height: f64) -> Section {
 fn close_open_chains(mut open: Vec<Vec<DVec2>>) -> Vec<Vec<DVec2>> {
     let mut loops = Vec::new();
     while let Some(mut chain) = open.pop() {
-        loop {
-            let (Some(&end), Some(&own_start)) = (chain.last(), chain.first()) else { break };
+        while let (Some(&end), Some(&own_start)) = (chain.last(), chain.first()) {
             let nearest = open
                 .iter()
                 .enumerate()
