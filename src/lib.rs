@@ -5,11 +5,13 @@
 //! - [`mesh`]: the one triangle-mesh type, its topology and components;
 //! - [`scan`]: reading OBJ/PLY/STL, validation and cleaning, the canonical body frame;
 //! - [`slice`]: horizontal cross-sections and their girths;
+//! - [`regions`]: body regions and landmarks (crotch, armpits, neck) from tracked slices;
 //! - [`report`]: what `dressform info` says about a scan;
 //! - [`output`]: atomic file writes.
 
 pub mod mesh;
 pub mod output;
+pub mod regions;
 pub mod report;
 pub mod scan;
 pub mod slice;

@@ -1,0 +1,163 @@
+//! Body regions from slices (in the spirit of Ju et al. 2000): the body is sliced every few
+//! millimetres and its loops are tracked from level to level, which finds the landmarks where
+//! the topology changes — the crotch (two leg loops merge into one), the armpits (arm loops
+//! join the torso), the neck (the narrowest torso level below the head) — and labels every
+//! loop torso, left/right leg, left/right arm or head.
+//!
+//! Tracking starts from the torso at 60% of the height (between crotch and armpits for any
+//! standing adult) and follows the loop that contains the previous loop's centroid, up and
+//! down. The subject's left is +X in the canonical frame.
+
+mod tracking;
+
+use crate::mesh::Mesh;
+use crate::slice::{Contour, Section};
+use glam::DVec2;
+use serde::Serialize;
+
+/// The part of the body a loop belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Region {
+    /// From the crotch to the neck (above the armpits it includes the shoulders).
+    Torso,
+    /// The subject's left leg (+X).
+    LeftLeg,
+    /// The subject's right leg (-X).
+    RightLeg,
+    /// The subject's left arm and hand, below the armpit.
+    LeftArm,
+    /// The subject's right arm and hand, below the armpit.
+    RightArm,
+    /// Above the neck.
+    Head,
+}
+
+/// Landmark heights (mm, canonical frame) and the arm cut.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Landmarks {
+    /// Body height.
+    pub height: f64,
+    /// Where the legs join: the lowest level with a single torso loop.
+    pub crotch: f64,
+    /// Where the left arm joins the torso.
+    pub left_armpit: f64,
+    /// Where the right arm joins the torso.
+    pub right_armpit: f64,
+    /// The narrowest torso level between the armpits and the head.
+    pub neck: f64,
+    /// Half-width (|x|) of the torso just below the armpits: the vertical planes x = ±this cut
+    /// the arms off the torso sections above the armpits, like a dress form's arm plates.
+    pub arm_cut: f64,
+}
+
+impl Landmarks {
+    /// The higher of the two armpits: above it, no section holds a separate arm.
+    pub fn armpit(&self) -> f64 {
+        self.left_armpit.max(self.right_armpit)
+    }
+}
+
+/// Why a body could not be segmented.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RegionError {
+    /// No section at mid-torso height.
+    #[error(
+        "no torso found at {z:.0} mm (60% of the height): is this a standing body in the canonical frame?"
+    )]
+    NoTorso {
+        /// The height looked at.
+        z: f64,
+    },
+    /// The torso reaches the floor without splitting into two legs.
+    #[error(
+        "no crotch found: the legs do not separate below the torso (legs together, or a skirt?)"
+    )]
+    NoCrotch,
+    /// No arm loop below the armpits on one side.
+    #[error(
+        "no {side} arm found beside the torso (arms must hang clear of the torso, as in an A-pose)"
+    )]
+    NoArm {
+        /// "left" or "right".
+        side: &'static str,
+    },
+}
+
+/// A body's tracked levels and landmarks; labels loops of any section.
+#[derive(Debug, Clone)]
+pub struct BodyRegions {
+    /// The landmarks found.
+    pub landmarks: Landmarks,
+    step: f64,
+    levels: Vec<LabelledSection>,
+}
+
+/// One tracked level: its loops and their labels.
+#[derive(Debug, Clone)]
+struct LabelledSection {
+    section: Section,
+    labels: Vec<Region>,
+}
+
+/// Default spacing of the tracking levels (mm).
+pub const TRACKING_STEP_MM: f64 = 5.0;
+
+impl BodyRegions {
+    /// Segments `body` (canonical frame), tracking loops every `step` mm.
+    pub fn find(body: &Mesh, step: f64) -> Result<BodyRegions, RegionError> {
+        tracking::track(body, step)
+    }
+
+    /// Labels for the loops of `section` (cut from the same body at any height): each loop
+    /// takes the label of the tracked loop at the nearest level that holds its centroid (or,
+    /// failing that, the nearest tracked centroid).
+    pub fn label(&self, section: &Section) -> Vec<Region> {
+        let i = ((section.height - self.levels[0].section.height) / self.step).round();
+        let level = &self.levels[(i.max(0.0) as usize).min(self.levels.len() - 1)];
+        section
+            .loops
+            .iter()
+            .map(|l| {
+                let c = l.centroid();
+                let tracked = &level.section.loops;
+                let inside = (0..tracked.len()).find(|&k| tracked[k].contains(c));
+                let nearest = || {
+                    (0..tracked.len()).min_by(|&a, &b| {
+                        let da = tracked[a].centroid().distance_squared(c);
+                        let db = tracked[b].centroid().distance_squared(c);
+                        da.total_cmp(&db)
+                    })
+                };
+                match inside.or_else(nearest) {
+                    Some(k) => level.labels[k],
+                    None => fallback_region(c, section.height, &self.landmarks),
+                }
+            })
+            .collect()
+    }
+}
+
+/// The region of a point at height `z` when no tracked loop is near: by landmarks alone.
+fn fallback_region(c: DVec2, z: f64, m: &Landmarks) -> Region {
+    match () {
+        _ if z >= m.neck => Region::Head,
+        _ if z >= m.crotch && c.x.abs() <= m.arm_cut => Region::Torso,
+        _ if z >= m.crotch => side(c, Region::LeftArm, Region::RightArm),
+        _ => side(c, Region::LeftLeg, Region::RightLeg),
+    }
+}
+
+/// `left` for a point on the subject's left (+X), else `right`.
+fn side(c: DVec2, left: Region, right: Region) -> Region {
+    if c.x >= 0.0 { left } else { right }
+}
+
+/// The largest loop of `section` labelled `region` (`labels` as from [`BodyRegions::label`]).
+pub fn largest_with<'a>(
+    section: &'a Section,
+    labels: &[Region],
+    region: Region,
+) -> Option<&'a Contour> {
+    section.loops.iter().zip(labels).find(|&(_, &r)| r == region).map(|(l, _)| l)
+}

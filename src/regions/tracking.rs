@@ -1,0 +1,155 @@
+//! Tracking loops from level to level to find the landmarks and label every loop.
+
+use super::{BodyRegions, LabelledSection, Landmarks, Region, RegionError, side};
+use crate::mesh::Mesh;
+use crate::slice::{Contour, Section, sections};
+use glam::DVec2;
+
+/// A jump of the torso's half-width between two levels that means an arm has joined (mm).
+const ARM_JOIN_JUMP_MM: f64 = 15.0;
+
+/// Index of the largest loop of `s` containing `p` (loops are sorted largest first).
+fn loop_containing(s: &Section, p: DVec2) -> Option<usize> {
+    s.loops.iter().position(|l| l.contains(p))
+}
+
+/// Follows the loop containing the previous loop's centroid through `levels` (in the order
+/// given), starting from loop `start` of the first; stops where no loop contains it. Returns
+/// (level index, loop index) pairs.
+fn follow(
+    sections: &[Section],
+    levels: impl Iterator<Item = usize>,
+    start: usize,
+) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut prev: Option<DVec2> = None;
+    for i in levels {
+        let k = match prev {
+            None => Some(start),
+            Some(c) => loop_containing(&sections[i], c),
+        };
+        let Some(k) = k else { break };
+        prev = Some(sections[i].loops[k].centroid());
+        out.push((i, k));
+    }
+    out
+}
+
+/// Horizontal extent of a loop: (min x, max x).
+fn x_range(c: &Contour) -> (f64, f64) {
+    c.points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)))
+}
+
+pub(super) fn track(body: &Mesh, step: f64) -> Result<BodyRegions, RegionError> {
+    let bounds = body.bounds().ok_or(RegionError::NoTorso { z: 0.0 })?;
+    let (floor, height) = (bounds.min.z, bounds.size().z);
+    let n = ((height / step).floor() as usize).max(1);
+    let heights: Vec<f64> = (0..n).map(|i| floor + step * (i as f64 + 0.5)).collect();
+    let sections = sections(body, &heights);
+    let z_of = |i: usize| heights[i];
+
+    let seed = ((0.6 * height / step) as usize).min(n - 1);
+    if sections[seed].loops.is_empty() {
+        return Err(RegionError::NoTorso { z: z_of(seed) });
+    }
+    let up = follow(&sections, seed..n, 0);
+    let down = follow(&sections, (0..=seed).rev(), 0);
+    let &(crotch_i, crotch_k) = down.last().expect("the seed is tracked");
+    if crotch_i == 0 {
+        return Err(RegionError::NoCrotch);
+    }
+    let mut torso: Vec<Option<usize>> = vec![None; n];
+    for &(i, k) in up.iter().chain(&down) {
+        torso[i] = Some(k);
+    }
+
+    // Legs: below the crotch, the largest loop on each side under the torso, then followed down.
+    let crotch_loop = &sections[crotch_i].loops[crotch_k];
+    let mid = crotch_loop.centroid().x;
+    let (lo, hi) = x_range(crotch_loop);
+    let below = &sections[crotch_i - 1];
+    let under = |want_left: bool| {
+        below.loops.iter().position(|l| {
+            let c = l.centroid();
+            (c.x > mid) == want_left && c.x > lo && c.x < hi
+        })
+    };
+    let (Some(left_k), Some(right_k)) = (under(true), under(false)) else {
+        return Err(RegionError::NoCrotch);
+    };
+    let mut leg: Vec<[Option<usize>; 2]> = vec![[None, None]; n];
+    for (s, k) in [(0, left_k), (1, right_k)] {
+        for (i, k) in follow(&sections, (0..crotch_i).rev(), k) {
+            leg[i][s] = Some(k);
+        }
+    }
+
+    // Armpits: going up from the seed, the level where the torso suddenly widens on that side.
+    let half_widths: Vec<(usize, f64, f64)> = up
+        .iter()
+        .map(|&(i, k)| {
+            let (lo, hi) = x_range(&sections[i].loops[k]);
+            (i, hi, -lo)
+        })
+        .collect();
+    let armpit = |pick: fn(&(usize, f64, f64)) -> f64, name: &'static str| {
+        half_widths
+            .windows(2)
+            .find(|w| pick(&w[1]) - pick(&w[0]) > ARM_JOIN_JUMP_MM)
+            .map(|w| (0.5 * (z_of(w[0].0) + z_of(w[1].0)), pick(&w[0])))
+            .ok_or(RegionError::NoArm { side: name })
+    };
+    let (left_armpit, left_cut) = armpit(|w| w.1, "left")?;
+    let (right_armpit, right_cut) = armpit(|w| w.2, "right")?;
+
+    // Neck: the narrowest torso level between the armpits and the head's widest level.
+    let girth = |&(i, k): &(usize, usize)| sections[i].loops[k].tape_girth();
+    let armpit_z = left_armpit.max(right_armpit);
+    let head_widest = up
+        .iter()
+        .filter(|&&(i, _)| z_of(i) >= floor + 0.87 * height)
+        .max_by(|a, b| girth(a).total_cmp(&girth(b)));
+    let neck = up
+        .iter()
+        .filter(|&&(i, _)| z_of(i) > armpit_z && head_widest.is_none_or(|h| i < h.0))
+        .min_by(|a, b| girth(a).total_cmp(&girth(b)))
+        .map_or(armpit_z + 0.5 * (floor + height - armpit_z), |&(i, _)| z_of(i));
+
+    let landmarks = Landmarks {
+        height,
+        crotch: z_of(crotch_i) - 0.5 * step,
+        left_armpit,
+        right_armpit,
+        neck,
+        arm_cut: 0.5 * (left_cut + right_cut),
+    };
+
+    let levels = sections
+        .into_iter()
+        .enumerate()
+        .map(|(i, section)| {
+            let z = z_of(i);
+            let head_loop = torso[i].filter(|_| z >= neck).map(|k| &section.loops[k]);
+            let labels = (0..section.loops.len())
+                .map(|k| {
+                    let c = section.loops[k].centroid();
+                    if torso[i] == Some(k) {
+                        if z >= neck { Region::Head } else { Region::Torso }
+                    } else if leg[i][0] == Some(k) {
+                        Region::LeftLeg
+                    } else if leg[i][1] == Some(k) {
+                        Region::RightLeg
+                    } else if z >= neck || head_loop.is_some_and(|h| h.contains(c)) {
+                        Region::Head
+                    } else {
+                        side(c, Region::LeftArm, Region::RightArm)
+                    }
+                })
+                .collect();
+            LabelledSection { section, labels }
+        })
+        .collect();
+    Ok(BodyRegions { landmarks, step, levels })
+}
