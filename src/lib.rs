@@ -6,12 +6,21 @@
 //! - [`scan`]: reading OBJ/PLY/STL, validation and cleaning, the canonical body frame;
 //! - [`slice`]: horizontal cross-sections and their girths;
 //! - [`regions`]: body regions and landmarks (crotch, armpits, neck) from tracked slices;
+//! - [`symmetry`]: axial (torso) and bilateral (legs) symmetry of sections, girth preserved;
+//! - [`mannequin`]: the symmetric mannequin: layers, symmetry, watertight rebuild;
+//! - [`measure`]: height, crotch height, chest/waist/hip girths; Table 1 and Fig. 11;
+//! - [`pipeline`]: scan to mannequin in one call; [`profiles`]: the `profiles.json` format;
 //! - [`report`]: what `dressform info` says about a scan;
 //! - [`output`]: atomic file writes.
 
+pub mod mannequin;
+pub mod measure;
 pub mod mesh;
 pub mod output;
+pub mod pipeline;
+pub mod profiles;
 pub mod regions;
 pub mod report;
 pub mod scan;
 pub mod slice;
+pub mod symmetry;

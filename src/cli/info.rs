@@ -1,6 +1,6 @@
 //! `dressform info <scan> [--json]`.
 
-use super::{Failure, FrameArgs};
+use super::{Failure, FrameArgs, warn};
 use dressform::report::ScanInfo;
 use dressform::scan;
 use std::path::PathBuf;
@@ -20,7 +20,7 @@ pub fn run(args: &InfoArgs) -> Result<(), Failure> {
     let scan = scan::load(&args.scan, &args.frame.options()).map_err(Failure::bad_input)?;
     let info = ScanInfo::new(&scan);
     for w in &info.warnings {
-        eprintln!("warning: {}: {w}", info.file);
+        warn(&info.file, w);
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&info).map_err(Failure::other)?);

@@ -2,6 +2,9 @@
 
 mod demo;
 mod info;
+mod measure;
+mod slice;
+mod symmetrize;
 
 use clap::{Parser, Subcommand};
 use dressform::scan::frame::{Direction, FrameOptions, Units};
@@ -18,6 +21,12 @@ pub struct Args {
 enum Command {
     /// Describe a scan: counts, units, up axis, facing, height, components, holes, manifoldness.
     Info(info::InfoArgs),
+    /// Cut a mesh by horizontal planes: each loop's label, contour length and tape girth.
+    Slice(slice::SliceArgs),
+    /// Measure a body: height, crotch height, chest, waist and hip girths and their levels.
+    Measure(measure::MeasureArgs),
+    /// Build the symmetric mannequin of a scan: mannequin.obj, profiles.json, measurements.json.
+    Symmetrize(symmetrize::SymmetrizeArgs),
     /// Run the pipeline on a built-in synthetic customer, no files or hardware needed.
     Demo(demo::DemoArgs),
 }
@@ -65,6 +74,28 @@ impl Failure {
 pub fn run(args: Args) -> Result<(), Failure> {
     match args.command {
         Command::Info(a) => info::run(&a),
+        Command::Slice(a) => slice::run(&a),
+        Command::Measure(a) => measure::run(&a),
+        Command::Symmetrize(a) => symmetrize::run(&a),
         Command::Demo(a) => demo::run(&a),
     }
+}
+
+/// Prints a warning about `file` on standard error.
+fn warn(file: &str, message: &str) {
+    eprintln!("warning: {file}: {message}");
+}
+
+/// A progress bar on standard error for `steps` steps; hidden in `--json` mode and when
+/// standard error is not a terminal.
+fn progress_bar(json: bool, steps: u64) -> indicatif::ProgressBar {
+    if json {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(steps);
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} [{bar:24}] {msg}") {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.enable_steady_tick(std::time::Duration::from_millis(100));
+    bar
 }

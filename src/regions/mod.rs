@@ -11,12 +11,12 @@
 mod tracking;
 
 use crate::mesh::Mesh;
-use crate::slice::{Contour, Section};
+use crate::slice::{Contour, Section, sections};
 use glam::DVec2;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The part of the body a loop belongs to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Region {
     /// From the crotch to the neck (above the armpits it includes the shoulders).
@@ -34,12 +34,14 @@ pub enum Region {
 }
 
 /// Landmark heights (mm, canonical frame) and the arm cut.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Landmarks {
     /// Body height.
     pub height: f64,
-    /// Where the legs join: the lowest level with a single torso loop.
+    /// Where the legs join (to 0.1 mm): just above it the torso is one loop.
     pub crotch: f64,
+    /// The narrowest level of the legs near the floor (the ankles): where the legs end.
+    pub ankle: f64,
     /// Where the left arm joins the torso.
     pub left_armpit: f64,
     /// Where the right arm joins the torso.
@@ -107,6 +109,24 @@ impl BodyRegions {
     /// Segments `body` (canonical frame), tracking loops every `step` mm.
     pub fn find(body: &Mesh, step: f64) -> Result<BodyRegions, RegionError> {
         tracking::track(body, step)
+    }
+
+    /// The torso's section at each of `heights` (`None` where there is none): the largest
+    /// loop labelled torso (at and above the neck, head), with the arms cut off at
+    /// x = ±`arm_cut` above the armpits.
+    pub fn torso_sections(&self, body: &Mesh, heights: &[f64]) -> Vec<Option<Contour>> {
+        let m = &self.landmarks;
+        sections(body, heights)
+            .into_iter()
+            .map(|s| {
+                let labels = self.label(&s);
+                let found = largest_with(&s, &labels, Region::Torso)
+                    .or_else(|| largest_with(&s, &labels, Region::Head));
+                found.map(|c| {
+                    if s.height > m.armpit() { c.clip_x(-m.arm_cut, m.arm_cut) } else { c.clone() }
+                })
+            })
+            .collect()
     }
 
     /// Labels for the loops of `section` (cut from the same body at any height): each loop

@@ -42,6 +42,17 @@ fn x_range(c: &Contour) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)))
 }
 
+/// The crotch between `below` (legs apart) and `above` (one torso loop around `inside`), by
+/// bisection to 0.1 mm.
+fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, inside: DVec2) -> f64 {
+    while above - below > 0.1 {
+        let mid = 0.5 * (below + above);
+        let s = &sections(body, &[mid])[0];
+        if loop_containing(s, inside).is_some() { above = mid } else { below = mid }
+    }
+    above
+}
+
 pub(super) fn track(body: &Mesh, step: f64) -> Result<BodyRegions, RegionError> {
     let bounds = body.bounds().ok_or(RegionError::NoTorso { z: 0.0 })?;
     let (floor, height) = (bounds.min.z, bounds.size().z);
@@ -117,9 +128,22 @@ pub(super) fn track(body: &Mesh, step: f64) -> Result<BodyRegions, RegionError> 
         .min_by(|a, b| girth(a).total_cmp(&girth(b)))
         .map_or(armpit_z + 0.5 * (floor + height - armpit_z), |&(i, _)| z_of(i));
 
+    // Ankle: the narrowest left-leg level between 3% and 15% of the height.
+    let ankle = (0..crotch_i)
+        .filter_map(|i| leg[i][0].map(|k| (i, sections[i].loops[k].tape_girth())))
+        .filter(|&(i, _)| (0.03..=0.15).contains(&((z_of(i) - floor) / height)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(floor + 0.08 * height, |(i, _)| z_of(i));
+
     let landmarks = Landmarks {
         height,
-        crotch: z_of(crotch_i) - 0.5 * step,
+        crotch: refine_crotch(
+            body,
+            z_of(crotch_i - 1),
+            z_of(crotch_i),
+            sections[crotch_i].loops[crotch_k].centroid(),
+        ),
+        ankle,
         left_armpit,
         right_armpit,
         neck,

@@ -44,6 +44,13 @@ impl Contour {
         sum / (6.0 * area)
     }
 
+    /// The part of the loop between the vertical lines x = `lo` and x = `hi` (Sutherland-
+    /// Hodgman clipping; the cuts become straight edges along the lines).
+    pub fn clip_x(&self, lo: f64, hi: f64) -> Contour {
+        let keep_right = clip_half_plane(&self.points, |p| p.x - lo);
+        Contour { points: clip_half_plane(&keep_right, |p| hi - p.x) }
+    }
+
     /// Whether `p` lies inside the loop (even-odd rule).
     pub fn contains(&self, p: DVec2) -> bool {
         let mut inside = false;
@@ -54,6 +61,23 @@ impl Contour {
         }
         inside
     }
+}
+
+/// The part of the closed polygon `points` where `side(p) >= 0` (`side` linear in `p`).
+fn clip_half_plane(points: &[DVec2], side: impl Fn(DVec2) -> f64) -> Vec<DVec2> {
+    let n = points.len();
+    let mut out = Vec::with_capacity(n + 2);
+    for i in 0..n {
+        let (a, b) = (points[i], points[(i + 1) % n]);
+        let (sa, sb) = (side(a), side(b));
+        if sa >= 0.0 {
+            out.push(a);
+        }
+        if (sa >= 0.0) != (sb >= 0.0) {
+            out.push(a + (b - a) * (sa / (sa - sb)));
+        }
+    }
+    out
 }
 
 /// Convex hull of `points`, counter-clockwise, without collinear points (Andrew's monotone
@@ -118,6 +142,16 @@ mod tests {
         let c = Contour { points: pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect() };
         assert!((c.tape_girth() - 40.0).abs() < 1e-12);
         assert!(c.perimeter() > 40.0);
+    }
+
+    #[test]
+    fn clipping_a_circle_to_a_band() {
+        let c = circle(10.0, 3600).clip_x(-6.0, 6.0);
+        assert!(c.points.iter().all(|p| p.x >= -6.0 - 1e-9 && p.x <= 6.0 + 1e-9));
+        // Two arcs of half-angle acos(0.6) each side... the band keeps x in [-6, 6].
+        let arc = 2.0 * 10.0 * (2.0 * (0.6f64).asin());
+        let expected = arc + 2.0 * 16.0;
+        assert!((c.perimeter() - expected).abs() < 0.01, "{} vs {expected}", c.perimeter());
     }
 
     #[test]

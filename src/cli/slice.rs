@@ -1,0 +1,108 @@
+//! `dressform slice <mesh> --heights 900,950,... [--json]`.
+
+use super::{Failure, FrameArgs, warn};
+use dressform::regions::{BodyRegions, Region, TRACKING_STEP_MM};
+use dressform::scan;
+use dressform::slice::sections;
+use serde::Serialize;
+use std::path::PathBuf;
+
+#[derive(Debug, clap::Args)]
+pub struct SliceArgs {
+    /// The mesh: an .obj, .ply or .stl file.
+    mesh: PathBuf,
+    /// Heights of the cutting planes in mm above the floor (canonical frame), comma-separated.
+    #[arg(long, value_delimiter = ',', required = true)]
+    heights: Vec<f64>,
+    /// Print JSON (documented in the README).
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    frame: FrameArgs,
+}
+
+#[derive(Serialize)]
+struct LoopOut {
+    label: Option<Region>,
+    perimeter_mm: f64,
+    tape_girth_mm: f64,
+    centroid_mm: [f64; 2],
+    points: usize,
+}
+
+#[derive(Serialize)]
+struct SectionOut {
+    z_mm: f64,
+    bridged_gaps: usize,
+    loops: Vec<LoopOut>,
+}
+
+#[derive(Serialize)]
+struct SliceOut {
+    file: String,
+    sections: Vec<SectionOut>,
+}
+
+pub fn run(args: &SliceArgs) -> Result<(), Failure> {
+    if let Some(h) = args.heights.iter().find(|h| !h.is_finite()) {
+        return Err(Failure::bad_input(format!("--heights: {h} is not a height")));
+    }
+    let scan = scan::load(&args.mesh, &args.frame.options()).map_err(Failure::bad_input)?;
+    let file = scan.source.display().to_string();
+    for w in scan.cleaning.warnings() {
+        warn(&file, &w);
+    }
+    let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM)
+        .map_err(|e| warn(&file, &format!("loops are not labelled: {e}")))
+        .ok();
+    let out = SliceOut {
+        file: file.clone(),
+        sections: sections(&scan.body, &args.heights)
+            .into_iter()
+            .map(|s| {
+                let labels = regions.as_ref().map(|r| r.label(&s));
+                if s.bridged_gaps > 0 {
+                    warn(
+                        &file,
+                        &format!(
+                            "closed {} open loops at z = {:.1} mm (holes in the scan)",
+                            s.bridged_gaps, s.height
+                        ),
+                    );
+                }
+                SectionOut {
+                    z_mm: s.height,
+                    bridged_gaps: s.bridged_gaps,
+                    loops: s
+                        .loops
+                        .iter()
+                        .enumerate()
+                        .map(|(k, l)| LoopOut {
+                            label: labels.as_ref().map(|ls| ls[k]),
+                            perimeter_mm: l.perimeter(),
+                            tape_girth_mm: l.tape_girth(),
+                            centroid_mm: l.centroid().to_array(),
+                            points: l.points.len(),
+                        })
+                        .collect(),
+                }
+            })
+            .collect(),
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&out).map_err(Failure::other)?);
+        return Ok(());
+    }
+    println!("{file}");
+    for s in &out.sections {
+        println!("  z = {:.1} mm: {} loops", s.z_mm, s.loops.len());
+        for l in &s.loops {
+            let label = l.label.map_or("unlabelled".to_string(), |r| format!("{r:?}"));
+            println!(
+                "    {label:<10} contour {:8.1} mm  tape girth {:8.1} mm  at ({:.0}, {:.0})",
+                l.perimeter_mm, l.tape_girth_mm, l.centroid_mm[0], l.centroid_mm[1]
+            );
+        }
+    }
+    Ok(())
+}

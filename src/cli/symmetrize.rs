@@ -1,0 +1,116 @@
+//! `dressform symmetrize <scan> -o <dir> [--torso-layers N] [--leg-layers N] [--rays N]
+//! [--preserve tape|contour] [--scan-frame] [--json]`.
+
+use super::{Failure, FrameArgs, progress_bar, warn};
+use dressform::mannequin::MannequinOptions;
+use dressform::measure::Comparison;
+use dressform::output::write_atomically;
+use dressform::pipeline::{STEPS, symmetrize};
+use dressform::profiles::Profiles;
+use dressform::scan::{self, format::Format};
+use dressform::symmetry::Preserve;
+use std::path::PathBuf;
+
+#[derive(Debug, clap::Args)]
+pub struct SymmetrizeArgs {
+    /// The scan: an .obj, .ply or .stl file.
+    scan: PathBuf,
+    /// Output directory (created if missing): mannequin.obj, profiles.json, measurements.json.
+    #[arg(short, long)]
+    out: PathBuf,
+    /// Torso layers.
+    #[arg(long, default_value_t = 100)]
+    torso_layers: usize,
+    /// Leg layers.
+    #[arg(long, default_value_t = 50)]
+    leg_layers: usize,
+    /// Rays per section (even).
+    #[arg(long, default_value_t = 360)]
+    rays: usize,
+    /// The girth every layer keeps: tape (convex hull) or contour (the paper's rule).
+    #[arg(long, value_enum, default_value_t = Preserve::Tape)]
+    preserve: Preserve,
+    /// Write mannequin.obj in the scan's own units and axes (default: the canonical frame).
+    #[arg(long)]
+    scan_frame: bool,
+    /// Print measurements.json to standard output instead of the table.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    frame: FrameArgs,
+}
+
+pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
+    let bar = progress_bar(args.json, STEPS.len() as u64 + 2);
+    bar.set_message("reading the scan");
+    let scan = scan::load(&args.scan, &args.frame.options()).map_err(Failure::bad_input)?;
+    let file = scan.source.display().to_string();
+    for w in scan.cleaning.warnings() {
+        bar.suspend(|| warn(&file, &w));
+    }
+    let options = MannequinOptions {
+        torso_layers: args.torso_layers,
+        leg_layers: args.leg_layers,
+        rays: args.rays,
+        preserve: args.preserve,
+    };
+    let result = symmetrize(&scan, &options, |step| {
+        bar.inc(1);
+        bar.set_message(STEPS[step]);
+    })
+    .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
+    bar.inc(1);
+    bar.set_message("writing");
+
+    std::fs::create_dir_all(&args.out).map_err(|e| {
+        Failure::other(format!("{}: cannot create the directory: {e}", args.out.display()))
+    })?;
+    let mesh = &result.mannequin.mesh;
+    let mesh =
+        if args.scan_frame { mesh.map_positions(|p| scan.frame.to_scan(p)) } else { mesh.clone() };
+    let measurements = pretty_json(&result.comparison)?;
+    let outputs = [
+        ("mannequin.obj", Format::Obj.encode(&mesh)),
+        ("profiles.json", pretty_json(&Profiles::of(&result.mannequin))?.into_bytes()),
+        ("measurements.json", measurements.clone().into_bytes()),
+    ];
+    for (name, bytes) in &outputs {
+        write_atomically(&args.out.join(name), bytes).map_err(Failure::other)?;
+    }
+    bar.finish_and_clear();
+    if args.json {
+        println!("{measurements}");
+    } else {
+        print_table(&file, &result.comparison, &args.out);
+    }
+    Ok(())
+}
+
+fn pretty_json(value: &impl serde::Serialize) -> Result<String, Failure> {
+    serde_json::to_string_pretty(value).map_err(Failure::other)
+}
+
+fn print_table(file: &str, c: &Comparison, out: &std::path::Path) {
+    println!("{file}: symmetric mannequin written to {}", out.display());
+    println!(
+        "  {:<6} {:>8} {:>12} {:>12} {:>9}",
+        "", "z (mm)", "input (mm)", "mannequin", "change"
+    );
+    for row in &c.table {
+        println!(
+            "  {:<6} {:>8.0} {:>12.1} {:>12.1} {:>+9.2}",
+            row.measure, row.z, row.input.tape, row.mannequin.tape, row.tape_change_mm
+        );
+    }
+    println!(
+        "  (tape girths; height {:.0} mm, crotch height {:.0} mm)",
+        c.input.height, c.input.crotch_height
+    );
+    println!("  {:<15} {:>10} {:>8} {:>8} {:>8}", "Fig. 11", "hip width", "chest", "waist", "hip");
+    for r in &c.mirrored {
+        println!(
+            "  {:<15} {:>10.1} {:>8.1} {:>8.1} {:>8.1}",
+            r.body, r.hip_width, r.chest, r.waist, r.hip
+        );
+    }
+}

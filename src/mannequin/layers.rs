@@ -1,0 +1,86 @@
+//! Cutting the torso and legs into layers and making each symmetric.
+
+use super::{Layer, MannequinError, MannequinOptions};
+use crate::mesh::Mesh;
+use crate::regions::{BodyRegions, Region, largest_with};
+use crate::slice::{Contour, sections};
+use crate::symmetry::{axial, bilateral, rays};
+use glam::DVec2;
+
+/// How far inside the crotch the first torso and last leg layers stay (mm): exactly at the
+/// crotch the torso loop is just forming.
+const CROTCH_CLEARANCE_MM: f64 = 1.0;
+
+/// `count` heights evenly spaced from `lo` to `hi` inclusive.
+fn spaced(lo: f64, hi: f64, count: usize) -> Vec<f64> {
+    (0..count).map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64).collect()
+}
+
+fn layer(region: Region, z: f64, centre: DVec2, points: Vec<DVec2>, input: &Contour) -> Layer {
+    let ring = Contour { points };
+    Layer {
+        region,
+        z,
+        centre: centre.to_array(),
+        input_tape_girth: input.tape_girth(),
+        input_contour_length: input.perimeter(),
+        tape_girth: ring.tape_girth(),
+        contour_length: ring.perimeter(),
+        points: ring.points,
+    }
+}
+
+/// The symmetric layers of a body, on one symmetry plane.
+pub(super) struct SymmetricLayers {
+    pub axis: f64,
+    pub torso: Vec<Layer>,
+    pub left_leg: Vec<Layer>,
+    pub right_leg: Vec<Layer>,
+}
+
+/// The symmetry axis and the symmetric torso, left-leg and right-leg layers.
+pub(super) fn symmetric_layers(
+    body: &Mesh,
+    regions: &BodyRegions,
+    o: &MannequinOptions,
+) -> Result<SymmetricLayers, MannequinError> {
+    let m = &regions.landmarks;
+    let torso_z = spaced(m.crotch + CROTCH_CLEARANCE_MM, m.neck, o.torso_layers);
+    let leg_z = spaced(m.ankle, m.crotch - CROTCH_CLEARANCE_MM, o.leg_layers);
+
+    // Torso sections, with the arms cut off above the armpits.
+    let torso_sections: Vec<(f64, Contour)> = torso_z
+        .iter()
+        .zip(regions.torso_sections(body, &torso_z))
+        .map(|(&z, c)| {
+            c.map(|c| (z, c)).ok_or(MannequinError::MissingLoop { region: Region::Torso, z })
+        })
+        .collect::<Result<_, _>>()?;
+    let mut centres: Vec<f64> =
+        torso_sections.iter().map(|(_, c)| rays::bbox_centre(c).x).collect();
+    centres.sort_by(f64::total_cmp);
+    let axis = centres[centres.len() / 2];
+
+    let torso = torso_sections
+        .iter()
+        .map(|(z, c)| {
+            let ring = axial::symmetrize(c, axis, o.rays, o.preserve)?;
+            Ok(layer(Region::Torso, *z, ring.centre, ring.points, c))
+        })
+        .collect::<Result<Vec<_>, MannequinError>>()?;
+
+    let mut left_leg = Vec::with_capacity(o.leg_layers);
+    let mut right_leg = Vec::with_capacity(o.leg_layers);
+    for s in sections(body, &leg_z) {
+        let labels = regions.label(&s);
+        let find = |region| {
+            largest_with(&s, &labels, region)
+                .ok_or(MannequinError::MissingLoop { region, z: s.height })
+        };
+        let (l, r) = (find(Region::LeftLeg)?, find(Region::RightLeg)?);
+        let [lr, rr] = bilateral::symmetrize(l, r, axis, o.rays, o.preserve)?;
+        left_leg.push(layer(Region::LeftLeg, s.height, lr.centre, lr.points, l));
+        right_leg.push(layer(Region::RightLeg, s.height, rr.centre, rr.points, r));
+    }
+    Ok(SymmetricLayers { axis, torso, left_leg, right_leg })
+}

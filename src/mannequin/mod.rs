@@ -1,0 +1,135 @@
+//! The symmetric mannequin: torso and legs cut into layers, each layer made symmetric
+//! ([`crate::symmetry`]), and the layers rebuilt into one watertight mesh ([`rebuild`]).
+//!
+//! Layers (defaults from the paper): 100 torso layers from just above the crotch to the neck,
+//! 50 leg layers from the ankles to just below the crotch. Above the armpits the torso sections
+//! are cut at x = ±`arm_cut` (vertical arm plates, as on a dress form), so the arms are not part
+//! of the torso. All layers share one symmetry plane, x = `axis`: the median of the torso
+//! sections' bounding-box centres.
+
+mod layers;
+mod rebuild;
+
+use crate::mesh::Mesh;
+use crate::regions::{BodyRegions, Landmarks, Region, RegionError};
+use crate::symmetry::{Preserve, SymmetryError};
+use glam::DVec2;
+use serde::Serialize;
+
+/// How the mannequin is built.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MannequinOptions {
+    /// Torso layers (paper: 100).
+    pub torso_layers: usize,
+    /// Leg layers (paper: 50).
+    pub leg_layers: usize,
+    /// Rays per section (paper: 360); even.
+    pub rays: usize,
+    /// The girth each layer keeps.
+    pub preserve: Preserve,
+}
+
+impl Default for MannequinOptions {
+    fn default() -> Self {
+        MannequinOptions { torso_layers: 100, leg_layers: 50, rays: 360, preserve: Preserve::Tape }
+    }
+}
+
+/// One symmetric layer: a horizontal ring of the mannequin.
+#[derive(Debug, Clone, Serialize)]
+pub struct Layer {
+    /// Torso, left leg or right leg.
+    pub region: Region,
+    /// Height (mm, canonical frame).
+    pub z: f64,
+    /// The ray origin of the layer.
+    pub centre: [f64; 2],
+    /// The ring, counter-clockwise from above, starting at the front (see [`crate::symmetry`]).
+    #[serde(serialize_with = "serialize_points")]
+    pub points: Vec<DVec2>,
+    /// The input section's tape girth (mm).
+    pub input_tape_girth: f64,
+    /// The input section's contour length (mm).
+    pub input_contour_length: f64,
+    /// The ring's tape girth (mm).
+    pub tape_girth: f64,
+    /// The ring's contour length (mm).
+    pub contour_length: f64,
+}
+
+fn serialize_points<S: serde::Serializer>(points: &[DVec2], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(points.iter().map(|p| [p.x, p.y]))
+}
+
+/// The symmetric mannequin.
+#[derive(Debug, Clone)]
+pub struct Mannequin {
+    /// The symmetry plane x = `axis` (mm).
+    pub axis: f64,
+    /// The landmarks of the input body.
+    pub landmarks: Landmarks,
+    /// The options used.
+    pub options: MannequinOptions,
+    /// Torso layers, bottom to top.
+    pub torso: Vec<Layer>,
+    /// Left-leg layers, bottom to top.
+    pub left_leg: Vec<Layer>,
+    /// Right-leg layers, bottom to top.
+    pub right_leg: Vec<Layer>,
+    /// The watertight, consistently oriented mannequin mesh.
+    pub mesh: Mesh,
+}
+
+/// Why a mannequin could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MannequinError {
+    /// Segmentation failed.
+    #[error(transparent)]
+    Regions(#[from] RegionError),
+    /// A section could not be made symmetric.
+    #[error(transparent)]
+    Symmetry(#[from] SymmetryError),
+    /// Too few layers.
+    #[error("at least 2 torso layers and 2 leg layers are needed (asked {torso} and {legs})")]
+    TooFewLayers {
+        /// Torso layers asked.
+        torso: usize,
+        /// Leg layers asked.
+        legs: usize,
+    },
+    /// A layer lacks the loop it needs.
+    #[error("no {region:?} loop at z = {z:.1} mm")]
+    MissingLoop {
+        /// The region looked for.
+        region: Region,
+        /// The height.
+        z: f64,
+    },
+}
+
+/// Builds the symmetric mannequin of `body` (canonical frame) segmented as `regions`.
+pub fn build(
+    body: &Mesh,
+    regions: &BodyRegions,
+    options: &MannequinOptions,
+) -> Result<Mannequin, MannequinError> {
+    if options.torso_layers < 2 || options.leg_layers < 2 {
+        return Err(MannequinError::TooFewLayers {
+            torso: options.torso_layers,
+            legs: options.leg_layers,
+        });
+    }
+    crate::symmetry::check_rays(options.rays)?;
+    let layers::SymmetricLayers { axis, torso, left_leg, right_leg } =
+        layers::symmetric_layers(body, regions, options)?;
+    let mesh = rebuild::rebuild(&torso, &left_leg, &right_leg, axis);
+    Ok(Mannequin {
+        axis,
+        landmarks: regions.landmarks,
+        options: *options,
+        torso,
+        left_leg,
+        right_leg,
+        mesh,
+    })
+}

@@ -1,0 +1,132 @@
+//! Body measurements as tailors take them, and the paper's comparisons (Table 1, Fig. 11).
+//!
+//! Every girth is horizontal and taken on the torso's loop; the tape girth is the convex
+//! hull's perimeter. Levels are found on the input body (canonical frame, mm):
+//! - **chest**: the largest torso tape girth from 10% of the height below the armpits up to
+//!   1% below them (bust/chest: maximum girth just below the armpits);
+//! - **hip**: where the buttocks protrude most (the torso's greatest +Y, i.e. backward, extent)
+//!   between the crotch and 35% of the way up to the armpits;
+//! - **waist**: the narrowest torso level between 30% and 80% of the way from the hip level to
+//!   the chest level; where that band has no narrowest point inside it (a round belly), the
+//!   level 55% of the way. (ISO 8559-1 puts the waist midway between the lowest rib and the
+//!   iliac crest; a scan has neither landmark, so the narrowing is the evidence used.)
+//! - **height**: the body's extent along Z; **crotch height**: the crotch landmark.
+//!
+//! The mannequin is measured at the same levels: it lives in the same frame, so a height on it
+//! is the same height on the input.
+
+mod compare;
+
+pub use compare::{Comparison, MirrorRow, TableRow, compare};
+
+use crate::mesh::Mesh;
+use crate::regions::BodyRegions;
+use crate::slice::{Contour, sections};
+use serde::Serialize;
+
+/// Sampling step when searching for measurement levels (mm).
+const LEVEL_STEP_MM: f64 = 2.0;
+
+/// A horizontal girth.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Girth {
+    /// Height (mm).
+    pub z: f64,
+    /// Tape girth: the convex hull's perimeter (mm).
+    pub tape: f64,
+    /// The contour's own length (mm).
+    pub contour: f64,
+}
+
+impl Girth {
+    fn of(z: f64, c: &Contour) -> Girth {
+        Girth { z, tape: c.tape_girth(), contour: c.perimeter() }
+    }
+}
+
+/// The measurement levels of a body.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Levels {
+    /// Chest level (mm).
+    pub chest: f64,
+    /// Waist level (mm).
+    pub waist: f64,
+    /// Hip level (mm).
+    pub hip: f64,
+}
+
+/// A body's measurements.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Measurements {
+    /// Height (mm).
+    pub height: f64,
+    /// Crotch height, the inseam (mm).
+    pub crotch_height: f64,
+    /// Chest girth.
+    pub chest: Girth,
+    /// Waist girth.
+    pub waist: Girth,
+    /// Hip girth.
+    pub hip: Girth,
+}
+
+/// Finds the chest, waist and hip levels (see the module documentation for the rules).
+pub fn levels(body: &Mesh, regions: &BodyRegions) -> Levels {
+    let m = &regions.landmarks;
+    let (lo, hi) = (m.crotch + LEVEL_STEP_MM, m.armpit() - LEVEL_STEP_MM);
+    let count = (((hi - lo) / LEVEL_STEP_MM) as usize).max(2);
+    let zs: Vec<f64> = (0..count).map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64).collect();
+    let loops = regions.torso_sections(body, &zs);
+    let samples: Vec<(f64, &Contour)> =
+        zs.iter().zip(&loops).filter_map(|(&z, l)| l.as_ref().map(|l| (z, l))).collect();
+    let best = |range: (f64, f64), score: &dyn Fn(&Contour) -> f64| {
+        samples
+            .iter()
+            .filter(|(z, _)| *z >= range.0 && *z <= range.1)
+            .map(|&(z, c)| (z, score(c)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+    };
+    let armpit = m.armpit();
+    let chest = best((armpit - 0.10 * m.height, armpit - 0.01 * m.height), &|c| c.tape_girth())
+        .map_or(armpit - 0.05 * m.height, |b| b.0);
+    let hip_band = (m.crotch, m.crotch + 0.35 * (armpit - m.crotch));
+    let back = |c: &Contour| c.points.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max);
+    let hip = best(hip_band, &back).map_or(m.crotch + 0.15 * (armpit - m.crotch), |b| b.0);
+    let band = (hip + 0.3 * (chest - hip), hip + 0.8 * (chest - hip));
+    let narrowest = best(band, &|c| -c.tape_girth()).map(|b| b.0);
+    let interior = narrowest.filter(|&z| z > band.0 + LEVEL_STEP_MM && z < band.1 - LEVEL_STEP_MM);
+    let waist = interior.unwrap_or(hip + 0.55 * (chest - hip));
+    Levels { chest, waist, hip }
+}
+
+/// Measures `body` at `levels`; `torso` picks the torso loop of a section.
+pub fn measure_at(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> Measurements {
+    let zs = [levels.chest, levels.waist, levels.hip];
+    let loops = regions.torso_sections(body, &zs);
+    let girth = |k: usize| {
+        loops[k]
+            .as_ref()
+            .map_or(Girth { z: zs[k], tape: 0.0, contour: 0.0 }, |c| Girth::of(zs[k], c))
+    };
+    Measurements {
+        height: regions.landmarks.height,
+        crotch_height: regions.landmarks.crotch,
+        chest: girth(0),
+        waist: girth(1),
+        hip: girth(2),
+    }
+}
+
+/// The loop around the symmetry plane x = `axis` at each height, for a mesh with no arms or
+/// head (the mannequin): `None` where the plane cuts nothing.
+pub fn central_loops(mesh: &Mesh, axis: f64, heights: &[f64]) -> Vec<Option<Contour>> {
+    sections(mesh, heights)
+        .into_iter()
+        .map(|s| {
+            let straddles = |c: &&Contour| {
+                c.points.iter().any(|p| p.x >= axis) && c.points.iter().any(|p| p.x <= axis)
+            };
+            s.loops.iter().find(straddles).cloned()
+        })
+        .collect()
+}

@@ -1,0 +1,37 @@
+//! The scan-to-mannequin pipeline as one call: segment, build the symmetric mannequin,
+//! measure both. Used by `symmetrize`, and by `run` and `demo`.
+
+use crate::mannequin::{self, Mannequin, MannequinError, MannequinOptions};
+use crate::measure::{Comparison, compare};
+use crate::regions::{BodyRegions, TRACKING_STEP_MM};
+use crate::scan::Scan;
+
+/// A scan's symmetric mannequin with its segmentation and measurements.
+#[derive(Debug, Clone)]
+pub struct Symmetrized {
+    /// The input body's regions and landmarks.
+    pub regions: BodyRegions,
+    /// The mannequin.
+    pub mannequin: Mannequin,
+    /// Table 1 and Fig. 11.
+    pub comparison: Comparison,
+}
+
+/// The steps of [`symmetrize`], reported to `progress` as they start.
+pub const STEPS: [&str; 3] =
+    ["segmenting the body", "building the symmetric mannequin", "measuring"];
+
+/// Builds the symmetric mannequin of `scan`, calling `progress(step)` before each step.
+pub fn symmetrize(
+    scan: &Scan,
+    options: &MannequinOptions,
+    mut progress: impl FnMut(usize),
+) -> Result<Symmetrized, MannequinError> {
+    progress(0);
+    let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM)?;
+    progress(1);
+    let mannequin = mannequin::build(&scan.body, &regions, options)?;
+    progress(2);
+    let comparison = compare(&scan.body, &regions, &mannequin);
+    Ok(Symmetrized { regions, mannequin, comparison })
+}

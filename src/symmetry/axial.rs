@@ -1,0 +1,120 @@
+//! Axial symmetry of a torso section (paper eq. 5-8).
+
+use super::{Preserve, SymmetryError, rays, rescale};
+use crate::slice::Contour;
+use glam::DVec2;
+
+/// A torso section made symmetric about the vertical plane x = `axis`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AxialRing {
+    /// The ray origin after the move onto the symmetry plane: (`axis`, bounding-box centre y).
+    pub centre: DVec2,
+    /// `n - 2` points, counter-clockwise from above, starting just left (+X) of the front
+    /// midline; the two rays on the symmetry line (0 and n/2) are dropped (paper, eq. 7).
+    pub points: Vec<DVec2>,
+}
+
+/// Makes `section` symmetric with `n` rays:
+/// - eq. 5: the centre is the section's bounding-box centre; the section is moved sideways so
+///   that the centre lies on the body's symmetry plane x = `axis` (one plane for the whole
+///   mannequin, so that it is mirror-symmetric as a whole);
+/// - eq. 6: ray `i` meets the contour at distance `r_i` (farthest crossing);
+/// - eq. 7: each ray and its mirror image take the mean `(r_i + r_(n-i)) / 2`;
+/// - eq. 8: the result is scaled about the centre to the section's original girth.
+pub fn symmetrize(
+    section: &Contour,
+    axis: f64,
+    n: usize,
+    preserve: Preserve,
+) -> Result<AxialRing, SymmetryError> {
+    super::check_rays(n)?;
+    if section.points.len() < 3 {
+        return Err(SymmetryError::EmptySection(f64::NAN));
+    }
+    let c = rays::bbox_centre(section);
+    let r = rays::cast(section, c, n);
+    let centre = DVec2::new(axis, c.y);
+    let mut points: Vec<DVec2> = (1..n)
+        .filter(|&i| i != n / 2)
+        .map(|i| centre + rays::direction(i, n) * (0.5 * (r[i] + r[n - i])))
+        .collect();
+    rescale(&mut points, centre, preserve, preserve.girth(section));
+    Ok(AxialRing { centre, points })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::TAU;
+
+    fn ellipse(a: f64, b: f64, centre: DVec2, m: usize) -> Contour {
+        Contour {
+            points: (0..m)
+                .map(|k| {
+                    let t = TAU * k as f64 / m as f64;
+                    centre + DVec2::new(a * t.cos(), b * t.sin())
+                })
+                .collect(),
+        }
+    }
+
+    fn assert_mirror_symmetric(ring: &AxialRing, axis: f64) {
+        let n = ring.points.len();
+        for (j, p) in ring.points.iter().enumerate() {
+            let partner = ring.points[n - 1 - j];
+            assert!((p.x - axis + partner.x - axis).abs() < 1e-9 && (p.y - partner.y).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn an_off_centre_asymmetric_section_becomes_symmetric_with_its_girth() {
+        // An egg: wider on the left, moved off the axis.
+        let mut egg = ellipse(150.0, 110.0, DVec2::new(23.0, -4.0), 720);
+        for p in &mut egg.points {
+            p.x += 0.0004 * (p.x - 23.0).max(0.0).powi(2);
+        }
+        for preserve in [Preserve::Tape, Preserve::Contour] {
+            let ring = symmetrize(&egg, 0.0, 360, preserve).unwrap();
+            assert_eq!(ring.points.len(), 358);
+            assert_mirror_symmetric(&ring, 0.0);
+            let out = Contour { points: ring.points.clone() };
+            assert!((preserve.girth(&out) - preserve.girth(&egg)).abs() < 1e-6);
+            assert!(out.signed_area() > 0.0);
+        }
+    }
+
+    #[test]
+    fn a_symmetric_section_is_unchanged() {
+        let e = ellipse(160.0, 120.0, DVec2::new(0.0, 30.0), 2000);
+        let ring = symmetrize(&e, 0.0, 360, Preserve::Tape).unwrap();
+        for p in &ring.points {
+            let q = (*p - DVec2::new(0.0, 30.0)) / DVec2::new(160.0, 120.0);
+            assert!((q.length() - 1.0).abs() < 1e-4, "{p} is off the ellipse");
+        }
+    }
+
+    #[test]
+    fn a_non_star_shaped_section_gives_a_simple_symmetric_ring() {
+        // A kidney: a disc with a deep bite from the back, as at a gluteal cleft or the crotch.
+        let kidney = Contour {
+            points: (0..720)
+                .map(|k| {
+                    let t = TAU * k as f64 / 720.0;
+                    let bite = 70.0 * (-(((t - TAU / 4.0) / 0.35).powi(2))).exp();
+                    DVec2::new(t.cos(), t.sin()) * (120.0 - bite)
+                })
+                .collect(),
+        };
+        let ring = symmetrize(&kidney, 0.0, 360, Preserve::Tape).unwrap();
+        assert_mirror_symmetric(&ring, 0.0);
+        let out = Contour { points: ring.points };
+        assert!((out.tape_girth() - kidney.tape_girth()).abs() < 1e-6);
+        assert!(out.signed_area() > 0.0, "still counter-clockwise");
+    }
+
+    #[test]
+    fn odd_ray_counts_are_refused() {
+        let e = ellipse(1.0, 1.0, DVec2::ZERO, 10);
+        assert_eq!(symmetrize(&e, 0.0, 359, Preserve::Tape), Err(SymmetryError::BadRayCount(359)));
+    }
+}

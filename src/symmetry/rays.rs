@@ -1,0 +1,116 @@
+//! Casting rays from a section's centre to its contour.
+//!
+//! A ray may cross a non-star-shaped contour several times (at the armpits, the crotch, a
+//! deep gluteal cleft); it takes its **farthest** crossing. That is one rule for every shape:
+//! for a star-shaped section it is the only crossing, and elsewhere it gives the outline a tape
+//! would follow across the concavity along that ray. A ray that misses the contour (possible
+//! only when the centre lies outside it) takes the contour's extent in its direction.
+
+use crate::slice::Contour;
+use glam::DVec2;
+use std::f64::consts::{PI, TAU};
+
+/// Unit direction of ray `i` of `n` (ray 0 to the front, -Y; counter-clockwise from above).
+pub fn direction(i: usize, n: usize) -> DVec2 {
+    let a = 1.5 * PI + TAU * i as f64 / n as f64;
+    DVec2::new(a.cos(), a.sin())
+}
+
+/// Distance from `centre` to the farthest crossing of `contour` along each of `n` rays.
+pub fn cast(contour: &Contour, centre: DVec2, n: usize) -> Vec<f64> {
+    let pts = &contour.points;
+    let m = pts.len();
+    (0..n)
+        .map(|i| {
+            let d = direction(i, n);
+            let mut farthest: Option<f64> = None;
+            for k in 0..m {
+                let (a, b) = (pts[k] - centre, pts[(k + 1) % m] - centre);
+                let e = b - a;
+                let denom = d.perp_dot(e);
+                if denom.abs() < 1e-300 {
+                    continue;
+                }
+                // centre + t d = a + s e  =>  t = a x e / (d x e), s = a x d / (d x e)
+                let t = a.perp_dot(e) / denom;
+                let s = a.perp_dot(d) / denom;
+                if t >= 0.0 && (0.0..=1.0).contains(&s) {
+                    farthest = Some(farthest.map_or(t, |f: f64| f.max(t)));
+                }
+            }
+            farthest.unwrap_or_else(|| pts.iter().map(|p| (*p - centre).dot(d)).fold(0.0, f64::max))
+        })
+        .collect()
+}
+
+/// Centre of a contour's bounding box (paper eq. 5 and eq. 9).
+pub fn bbox_centre(contour: &Contour) -> DVec2 {
+    let (lo, hi) = contour
+        .points
+        .iter()
+        .fold((DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+    (lo + hi) * 0.5
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn directions_start_at_the_front_and_mirror_pairwise() {
+        let n = 360;
+        assert!((direction(0, n) - DVec2::NEG_Y).length() < 1e-12);
+        assert!((direction(n / 2, n) - DVec2::Y).length() < 1e-12);
+        assert!(
+            direction(1, n).x > 0.0,
+            "counter-clockwise from the front goes to the subject's left (+X)"
+        );
+        for i in 1..n {
+            let (a, b) = (direction(i, n), direction(n - i, n));
+            assert!((a.x + b.x).abs() < 1e-12 && (a.y - b.y).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn square_radii() {
+        let sq = Contour {
+            points: vec![
+                DVec2::new(-1., -1.),
+                DVec2::new(1., -1.),
+                DVec2::new(1., 1.),
+                DVec2::new(-1., 1.),
+            ],
+        };
+        let r = cast(&sq, DVec2::ZERO, 8);
+        for (i, r) in r.iter().enumerate() {
+            let expected = if i % 2 == 0 { 1.0 } else { 2f64.sqrt() };
+            assert!((r - expected).abs() < 1e-12, "ray {i}: {r}");
+        }
+    }
+
+    #[test]
+    fn a_ray_crossing_twice_takes_the_farthest_crossing() {
+        // A "C" opening to +X: the ray to +X from the centre crosses the two arms' tips.
+        let c = Contour {
+            points: [
+                (-2., -2.),
+                (2., -2.),
+                (2., -1.),
+                (-1., -1.),
+                (-1., 1.),
+                (2., 1.),
+                (2., 2.),
+                (-2., 2.),
+            ]
+            .iter()
+            .map(|&(x, y)| DVec2::new(x, y))
+            .collect(),
+        };
+        let r = cast(&c, DVec2::ZERO, 4); // rays: -Y, +X, +Y, -X
+        assert!((r[0] - 2.0).abs() < 1e-12);
+        assert!((r[3] - 2.0).abs() < 1e-12, "-X hits the back of the C");
+        assert!(r[1] >= 0.0, "+X goes through the opening: the contour's extent, {}", r[1]);
+    }
+}
