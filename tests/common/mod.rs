@@ -31,3 +31,107 @@ pub fn dressform(args: &[&str]) -> (i32, String, String) {
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
 }
+
+use dressform::mesh::Mesh;
+use glam::DVec3;
+use std::collections::HashMap;
+
+/// Closest point to `p` on triangle `abc` (Ericson, Real-Time Collision Detection, 5.1.5).
+pub fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    a + ab * (vb * denom) + ac * (vc * denom)
+}
+
+/// Distances from points to a surface, with the triangles bucketed by height so that a query
+/// only looks at triangles within `reach` mm of its height.
+pub struct SurfaceDistance<'a> {
+    mesh: &'a Mesh,
+    reach: f64,
+    bins: HashMap<i64, Vec<usize>>,
+}
+
+impl<'a> SurfaceDistance<'a> {
+    pub fn new(mesh: &'a Mesh, reach: f64) -> Self {
+        let mut bins: HashMap<i64, Vec<usize>> = HashMap::new();
+        for t in 0..mesh.triangles.len() {
+            let z = mesh.corners(t).map(|p| p.z);
+            let lo = (z[0].min(z[1]).min(z[2]) / reach).floor() as i64;
+            let hi = (z[0].max(z[1]).max(z[2]) / reach).floor() as i64;
+            for b in lo..=hi {
+                bins.entry(b).or_default().push(t);
+            }
+        }
+        SurfaceDistance { mesh, reach, bins }
+    }
+
+    /// Distance from `p` to the surface, if the surface comes within `reach` of it.
+    pub fn distance(&self, p: DVec3) -> Option<f64> {
+        let b = (p.z / self.reach).floor() as i64;
+        (b - 1..=b + 1)
+            .filter_map(|k| self.bins.get(&k))
+            .flatten()
+            .map(|&t| {
+                let [a, b, c] = self.mesh.corners(t);
+                closest_on_triangle(p, a, b, c).distance(p)
+            })
+            .min_by(f64::total_cmp)
+    }
+}
+
+/// The largest distance from any vertex of `mesh` to the nearest vertex of its mirror image
+/// about the plane x = `axis`.
+pub fn largest_mirror_gap(mesh: &Mesh, axis: f64) -> f64 {
+    let cell = 1.0;
+    let key = |p: DVec3| {
+        ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64, (p.z / cell).floor() as i64)
+    };
+    let mut grid: HashMap<(i64, i64, i64), Vec<DVec3>> = HashMap::new();
+    for &p in &mesh.positions {
+        grid.entry(key(p)).or_default().push(p);
+    }
+    mesh.positions
+        .iter()
+        .map(|&p| {
+            let m = DVec3::new(2.0 * axis - p.x, p.y, p.z);
+            let (i, j, k) = key(m);
+            let mut best = f64::INFINITY;
+            for di in -1..=1 {
+                for dj in -1..=1 {
+                    for dk in -1..=1 {
+                        for q in grid.get(&(i + di, j + dj, k + dk)).into_iter().flatten() {
+                            best = best.min(q.distance(m));
+                        }
+                    }
+                }
+            }
+            best
+        })
+        .fold(0.0, f64::max)
+}
