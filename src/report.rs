@@ -1,7 +1,7 @@
 //! The `dressform info` report on a scan: what was read, what cleaning did, the frame found,
 //! and the body's size and topology. Serialised as the documented `--json` output.
 
-use crate::mesh::Aabb;
+use crate::mesh::{Aabb, topology};
 use crate::scan::Scan;
 use crate::scan::clean::DroppedComponent;
 use crate::scan::frame::{Direction, Units};
@@ -99,7 +99,7 @@ pub struct CleaningInfo {
 impl ScanInfo {
     /// The report on `scan`.
     pub fn new(scan: &Scan) -> Self {
-        let t = &scan.cleaning.topology;
+        let t = &topology(&scan.body);
         let body = &scan.body;
         let frame = &scan.frame;
         ScanInfo {
@@ -137,7 +137,7 @@ impl ScanInfo {
                 welded_vertices: scan.cleaning.welded_vertices,
                 degenerate_triangles: scan.cleaning.degenerate_triangles,
             },
-            warnings: scan.cleaning.warnings(),
+            warnings: scan.cleaning.warnings().into_iter().chain(t.warnings()).collect(),
         }
     }
 }

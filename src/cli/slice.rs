@@ -89,6 +89,18 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
             })
             .collect(),
     };
+    let gaps: Vec<&SectionOut> = out.sections.iter().filter(|s| s.bridged_gaps > 0).collect();
+    if !gaps.is_empty() {
+        let total: usize = gaps.iter().map(|s| s.bridged_gaps).sum();
+        warn(
+            &file,
+            &format!(
+                "closed {total} open loops on {} of {} planes (holes in the scan; see bridged_gaps per plane)",
+                gaps.len(),
+                out.sections.len()
+            ),
+        );
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&out).map_err(Failure::other)?);
         return Ok(());

@@ -4,6 +4,7 @@
 use super::{Failure, FrameArgs, progress_bar, warn};
 use dressform::mannequin::MannequinOptions;
 use dressform::measure::Comparison;
+use dressform::mesh::topology;
 use dressform::output::write_atomically;
 use dressform::pipeline::{STEPS, symmetrize};
 use dressform::profiles::Profiles;
@@ -45,7 +46,7 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     bar.set_message("reading the scan");
     let scan = scan::load(&args.scan, &args.frame.options()).map_err(Failure::bad_input)?;
     let file = scan.source.display().to_string();
-    for w in scan.cleaning.warnings() {
+    for w in scan.cleaning.warnings().into_iter().chain(topology(&scan.body).warnings()) {
         bar.suspend(|| warn(&file, &w));
     }
     let options = MannequinOptions {

@@ -3,11 +3,12 @@
 //! A [`Mesh`] is an indexed triangle list in `f64`. Readers produce it, the canonical frame
 //! moves it, slicing and symmetry read it, writers store it.
 
+mod adjacency;
 mod components;
 mod topology;
 mod weld;
 
-pub use components::{Component, components};
+pub use components::{Component, Components, components};
 pub use topology::{Topology, topology};
 
 use glam::DVec3;
@@ -107,21 +108,28 @@ impl Mesh {
         self.drop_unused_vertices();
     }
 
-    /// Removes vertices no triangle refers to, renumbering the triangles.
+    /// Removes vertices no triangle refers to, keeping the others in their order.
     pub fn drop_unused_vertices(&mut self) {
+        let mut used = vec![false; self.positions.len()];
+        for &i in self.triangles.iter().flatten() {
+            used[i as usize] = true;
+        }
+        if used.iter().all(|&u| u) {
+            return;
+        }
         let mut new_index = vec![u32::MAX; self.positions.len()];
-        let mut positions = Vec::with_capacity(self.positions.len());
-        for tri in &mut self.triangles {
-            for i in tri.iter_mut() {
-                let slot = &mut new_index[*i as usize];
-                if *slot == u32::MAX {
-                    *slot = positions.len() as u32;
-                    positions.push(self.positions[*i as usize]);
-                }
-                *i = *slot;
+        let mut next = 0;
+        for (i, &u) in used.iter().enumerate() {
+            if u {
+                new_index[i] = next;
+                self.positions[next as usize] = self.positions[i];
+                next += 1;
             }
         }
-        self.positions = positions;
+        self.positions.truncate(next as usize);
+        for tri in &mut self.triangles {
+            *tri = tri.map(|i| new_index[i as usize]);
+        }
     }
 
     /// Merges vertices with bit-identical positions; returns how many were merged away.

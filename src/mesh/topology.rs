@@ -1,8 +1,9 @@
 //! Edge topology: boundaries (holes), non-manifold edges and vertices, orientation.
 
 use super::Mesh;
-use super::components::DisjointSets;
-use std::collections::HashMap;
+use super::adjacency::Incidence;
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 
 /// What the edges of a mesh say about its surface.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -36,77 +37,119 @@ impl Topology {
     pub fn is_consistently_oriented(&self) -> bool {
         self.misoriented_edges == 0
     }
+
+    /// Human-readable warnings about holes, non-manifold spots and flipped faces.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        if !self.boundary_loops.is_empty() {
+            w.push(format!("the body has {} holes (boundary loops)", self.boundary_loops.len()));
+        }
+        if !self.is_manifold() {
+            w.push(format!(
+                "the body is not manifold: {} edges with more than two faces, {} vertices joining separate fans",
+                self.non_manifold_edges, self.non_manifold_vertices
+            ));
+        }
+        if self.misoriented_edges > 0 {
+            w.push(format!("{} edges join faces of opposite orientation", self.misoriented_edges));
+        }
+        w
+    }
 }
 
-/// Half-edge `k` of triangle `t` runs from corner `k` to corner `k + 1`.
+/// Half-edge `h` runs from corner `h % 3` to the next corner of triangle `h / 3`.
 fn half_edge(mesh: &Mesh, h: usize) -> (u32, u32) {
     let tri = mesh.triangles[h / 3];
     (tri[h % 3], tri[(h + 1) % 3])
 }
 
-/// Index of the corner of triangle `h / 3` that holds vertex `v`.
-fn corner_of(mesh: &Mesh, h: usize, v: u32) -> usize {
-    let t = h / 3;
-    let k = mesh.triangles[t].iter().position(|&x| x == v).unwrap_or(0);
-    3 * t + k
-}
-
-/// Analyses the edges of `mesh`. Sorting the half-edges by their undirected key keeps this
-/// `O(n log n)` without a hash map per edge.
+/// Analyses the edges of `mesh` in linear time: half-edges are grouped by their lower vertex
+/// (a counting sort), and within each small group by their upper vertex; vertex ranges are
+/// processed in parallel.
 pub fn topology(mesh: &Mesh) -> Topology {
-    let mut keyed: Vec<(u64, u32)> = (0..mesh.triangles.len() * 3)
-        .map(|h| {
-            let (a, b) = half_edge(mesh, h);
-            let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
-            (key, h as u32)
+    let by_vertex = Incidence::half_edges_by_lower_vertex(mesh);
+    let around = Incidence::triangles(mesh);
+    let n = mesh.positions.len();
+    let chunk = n.div_ceil(rayon::current_num_threads() * 8).max(1024);
+    let parts: Vec<(Topology, Vec<(u32, u32)>)> = (0..n.div_ceil(chunk))
+        .into_par_iter()
+        .map(|c| {
+            let mut topo = Topology::default();
+            let mut boundary = Vec::new();
+            let mut group: Vec<(u32, u32)> = Vec::new();
+            for v in c * chunk..((c + 1) * chunk).min(n) {
+                group.clear();
+                group.extend(by_vertex.of(v).iter().map(|&h| {
+                    let (a, b) = half_edge(mesh, h as usize);
+                    (a.max(b), h)
+                }));
+                group.sort_unstable();
+                for run in group.chunk_by(|x, y| x.0 == y.0) {
+                    topo.edges += 1;
+                    match run {
+                        [(_, h)] => {
+                            topo.boundary_edges += 1;
+                            boundary.push(half_edge(mesh, *h as usize));
+                        }
+                        [(_, h1), (_, h2)] => {
+                            if half_edge(mesh, *h1 as usize) == half_edge(mesh, *h2 as usize) {
+                                topo.misoriented_edges += 1;
+                            }
+                        }
+                        _ => topo.non_manifold_edges += 1,
+                    }
+                }
+                if fans(mesh, v as u32, around.of(v)) > 1 {
+                    topo.non_manifold_vertices += 1;
+                }
+            }
+            (topo, boundary)
         })
         .collect();
-    keyed.sort_unstable();
-
     let mut topo = Topology::default();
-    let mut fans = DisjointSets::new(mesh.triangles.len() * 3);
     let mut boundary = Vec::new();
-    for run in keyed.chunk_by(|x, y| x.0 == y.0) {
-        topo.edges += 1;
-        match run {
-            [(_, h)] => {
-                topo.boundary_edges += 1;
-                boundary.push(half_edge(mesh, *h as usize));
-            }
-            [(_, h1), (_, h2)] => {
-                let (h1, h2) = (*h1 as usize, *h2 as usize);
-                let (a, b) = half_edge(mesh, h1);
-                if half_edge(mesh, h2) == (a, b) {
-                    topo.misoriented_edges += 1;
-                }
-                fans.union(corner_of(mesh, h1, a), corner_of(mesh, h2, a));
-                fans.union(corner_of(mesh, h1, b), corner_of(mesh, h2, b));
-            }
-            _ => topo.non_manifold_edges += 1,
-        }
+    for (t, b) in parts {
+        topo.edges += t.edges;
+        topo.boundary_edges += t.boundary_edges;
+        topo.non_manifold_edges += t.non_manifold_edges;
+        topo.non_manifold_vertices += t.non_manifold_vertices;
+        topo.misoriented_edges += t.misoriented_edges;
+        boundary.extend(b);
     }
-
-    let mut fan_of_vertex = vec![usize::MAX; mesh.positions.len()];
-    let mut split = vec![false; mesh.positions.len()];
-    for corner in 0..mesh.triangles.len() * 3 {
-        let v = mesh.triangles[corner / 3][corner % 3] as usize;
-        let root = fans.find(corner);
-        if fan_of_vertex[v] == usize::MAX {
-            fan_of_vertex[v] = root;
-        } else if fan_of_vertex[v] != root {
-            split[v] = true;
-        }
-    }
-    topo.non_manifold_vertices = split.iter().filter(|&&s| s).count();
     topo.boundary_loops = chain_loops(&boundary);
     topo
+}
+
+/// How many fans the triangles around vertex `v` form: triangles are in one fan when they
+/// are linked through edges at `v` (sharing `v` and one more vertex).
+fn fans(mesh: &Mesh, v: u32, triangles: &[u32]) -> usize {
+    let n = triangles.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let others = |t: u32| mesh.triangles[t as usize];
+    for i in 0..n {
+        for j in i + 1..n {
+            let (a, b) = (others(triangles[i]), others(triangles[j]));
+            if a.iter().any(|&x| x != v && b.contains(&x)) {
+                let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
+                parent[ri] = rj;
+            }
+        }
+    }
+    (0..n).filter(|&i| root(&mut parent, i) == i).count()
 }
 
 /// Chains directed boundary edges into loops. Where several boundary edges leave one vertex
 /// (a non-manifold boundary), any unused one is taken; a chain that cannot close is still
 /// reported as one (open) loop so that every boundary edge belongs to exactly one loop.
 fn chain_loops(edges: &[(u32, u32)]) -> Vec<Vec<u32>> {
-    let mut leaving: HashMap<u32, Vec<usize>> = HashMap::new();
+    let mut leaving: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
     for (i, &(a, _)) in edges.iter().enumerate() {
         leaving.entry(a).or_default().push(i);
     }

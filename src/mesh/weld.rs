@@ -4,24 +4,28 @@
 //! merging bit-identical positions restores the connectivity the scanner meant.
 
 use super::Mesh;
-use std::collections::HashMap;
+use rayon::prelude::*;
 
-/// Merges vertices with bit-identical positions (`-0.0` and `0.0` count as one); returns how
-/// many vertices were merged away. Vertices no triangle uses are dropped too.
+/// Merges vertices with bit-identical positions (`-0.0` and `0.0` count as one) into the first
+/// of them; returns how many were merged away. Vertices no triangle uses are dropped too.
+/// A parallel sort of the positions' bit patterns finds the duplicates.
 pub(super) fn weld_identical(mesh: &mut Mesh) -> usize {
-    let before = mesh.positions.len();
-    let mut first_at: HashMap<[u64; 3], u32> = HashMap::with_capacity(before);
-    let mut remap = Vec::with_capacity(before);
-    for (i, p) in mesh.positions.iter().enumerate() {
-        let key = p.to_array().map(|c| (c + 0.0).to_bits());
-        remap.push(*first_at.entry(key).or_insert(i as u32));
-    }
-    for tri in &mut mesh.triangles {
-        for i in tri.iter_mut() {
-            *i = remap[*i as usize];
+    let key = |i: u32| mesh.positions[i as usize].to_array().map(|c| (c + 0.0).to_bits());
+    let mut order: Vec<u32> = (0..mesh.positions.len() as u32).collect();
+    order.par_sort_unstable_by_key(|&i| (key(i), i));
+    let mut remap: Vec<u32> = (0..mesh.positions.len() as u32).collect();
+    let mut merged = 0;
+    for run in order.chunk_by(|&a, &b| key(a) == key(b)) {
+        for &i in &run[1..] {
+            remap[i as usize] = run[0];
+            merged += 1;
         }
     }
-    let distinct = first_at.len();
+    if merged > 0 {
+        for tri in &mut mesh.triangles {
+            *tri = tri.map(|i| remap[i as usize]);
+        }
+    }
     mesh.drop_unused_vertices();
-    before - distinct
+    merged
 }

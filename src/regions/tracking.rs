@@ -2,7 +2,7 @@
 
 use super::{BodyRegions, LabelledSection, Landmarks, Region, RegionError, side};
 use crate::mesh::Mesh;
-use crate::slice::{Contour, Section, sections};
+use crate::slice::{Contour, Section, sections, sections_among};
 use glam::DVec2;
 
 /// A jump of the torso's half-width between two levels that means an arm has joined (mm).
@@ -43,11 +43,20 @@ fn x_range(c: &Contour) -> (f64, f64) {
 }
 
 /// The crotch between `below` (legs apart) and `above` (one torso loop around `inside`), by
-/// bisection to 0.1 mm.
+/// bisection to 0.1 mm, cutting only the triangles between the two heights.
 fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, inside: DVec2) -> f64 {
+    let near: Vec<[u32; 3]> = body
+        .triangles
+        .iter()
+        .filter(|tri| {
+            let z = tri.map(|v| body.positions[v as usize].z);
+            z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
+        })
+        .copied()
+        .collect();
     while above - below > 0.1 {
         let mid = 0.5 * (below + above);
-        let s = &sections(body, &[mid])[0];
+        let s = &sections_among(body, &near, &[mid])[0];
         if loop_containing(s, inside).is_some() { above = mid } else { below = mid }
     }
     above

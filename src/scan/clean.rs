@@ -6,9 +6,11 @@
 //! - degenerate triangles (repeated corner, zero area): dropped;
 //! - several connected components: the largest by area is the body; floor patches, props and
 //!   noise islands are dropped and listed;
-//! - holes (boundary loops), non-manifold edges and vertices: counted, kept.
+//!
+//! Holes, non-manifold edges and vertices are a diagnosis, not a repair: see
+//! [`crate::mesh::topology`] and [`Topology::warnings`].
 
-use crate::mesh::{Aabb, Mesh, Topology, components, topology};
+use crate::mesh::{Aabb, Mesh, components};
 use serde::Serialize;
 
 /// What cleaning found and did.
@@ -22,9 +24,6 @@ pub struct CleaningReport {
     pub components: usize,
     /// The components dropped, largest first.
     pub dropped_components: Vec<DroppedComponent>,
-    /// Edge topology of the kept body.
-    #[serde(skip)]
-    pub topology: Topology,
 }
 
 /// A connected piece that is not the body.
@@ -80,19 +79,6 @@ impl CleaningReport {
                 100.0 * share
             ));
         }
-        let t = &self.topology;
-        if !t.boundary_loops.is_empty() {
-            w.push(format!("the body has {} holes (boundary loops)", t.boundary_loops.len()));
-        }
-        if t.non_manifold_edges > 0 || t.non_manifold_vertices > 0 {
-            w.push(format!(
-                "the body is not manifold: {} edges with more than two faces, {} vertices joining separate fans",
-                t.non_manifold_edges, t.non_manifold_vertices
-            ));
-        }
-        if t.misoriented_edges > 0 {
-            w.push(format!("{} edges join faces of opposite orientation", t.misoriented_edges));
-        }
         w
     }
 }
@@ -118,30 +104,24 @@ pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
         return Err(CleanError::AllDegenerate);
     }
 
-    let parts = components(&mesh);
-    let total: f64 = parts.iter().map(|c| c.area).sum();
-    let dropped_components = parts[1..]
+    let found = components(&mesh);
+    let total: f64 = found.parts.iter().map(|c| c.area).sum();
+    let dropped_components = found.parts[1..]
         .iter()
         .map(|c| DroppedComponent {
-            triangles: c.triangles.len(),
+            triangles: c.triangles,
             area_fraction: c.area / total,
             bounds: c.bounds,
         })
         .collect();
-    if parts.len() > 1 {
-        let mut keep = vec![false; mesh.triangles.len()];
-        for &t in &parts[0].triangles {
-            keep[t] = true;
-        }
-        mesh.retain_triangles(|t| keep[t]);
+    if found.parts.len() > 1 {
+        mesh.retain_triangles(|t| found.of_triangle[t] == 0);
     }
-    let topology = topology(&mesh);
     let report = CleaningReport {
         welded_vertices,
         degenerate_triangles,
-        components: parts.len(),
+        components: found.parts.len(),
         dropped_components,
-        topology,
     };
     Ok((mesh, report))
 }

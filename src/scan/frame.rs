@@ -17,6 +17,7 @@
 
 use crate::mesh::Mesh;
 use glam::{DMat3, DVec2, DVec3};
+use rayon::prelude::*;
 use serde::Serialize;
 use std::fmt;
 use std::str::FromStr;
@@ -197,78 +198,109 @@ impl CanonicalFrame {
     }
 }
 
-/// Area-weighted triangle centroids, with heights along the up direction.
-struct Samples {
-    points: Vec<(DVec3, f64)>,
-    up: DVec3,
-    floor: f64,
-    height: f64,
+/// Area-weighted sums over triangle centroids: weight, first moment, and the second moments
+/// of two horizontal coordinates.
+#[derive(Debug, Clone, Copy, Default)]
+struct Moments {
+    weight: f64,
+    sum: DVec3,
+    xx: f64,
+    xy: f64,
+    yy: f64,
 }
 
-impl Samples {
-    /// Samples whose height lies in `[lo, hi]` (fractions of the body's height).
-    fn band(&self, lo: f64, hi: f64) -> impl Iterator<Item = (DVec3, f64)> + '_ {
-        self.points.iter().copied().filter(move |(p, _)| {
-            let f = (p.dot(self.up) - self.floor) / self.height;
-            (lo..=hi).contains(&f)
-        })
+impl Moments {
+    fn add(&mut self, p: DVec3, a: f64, flat: DVec2) {
+        self.weight += a;
+        self.sum += p * a;
+        self.xx += a * flat.x * flat.x;
+        self.xy += a * flat.x * flat.y;
+        self.yy += a * flat.y * flat.y;
+    }
+
+    fn merge(mut self, o: Moments) -> Moments {
+        self.weight += o.weight;
+        self.sum += o.sum;
+        self.xx += o.xx;
+        self.xy += o.xy;
+        self.yy += o.yy;
+        self
+    }
+
+    fn mean(&self) -> Option<DVec3> {
+        (self.weight > 0.0).then(|| self.sum / self.weight)
     }
 }
 
-/// Area-weighted mean of `samples`, or `None` when they carry no area.
-fn mean(samples: impl Iterator<Item = (DVec3, f64)>) -> Option<DVec3> {
-    let (sum, weight) = samples.fold((DVec3::ZERO, 0.0), |(s, w), (p, a)| (s + p * a, w + a));
-    (weight > 0.0).then(|| sum / weight)
+/// Sums `moments(centroid, area)` over all triangles, in parallel.
+fn accumulate<const N: usize>(
+    mesh: &Mesh,
+    add: impl Fn(&mut [Moments; N], DVec3, f64) + Sync,
+) -> [Moments; N] {
+    (0..mesh.triangles.len())
+        .into_par_iter()
+        .fold(
+            || [Moments::default(); N],
+            |mut acc, t| {
+                let [a, b, c] = mesh.corners(t);
+                add(&mut acc, (a + b + c) / 3.0, 0.5 * (b - a).cross(c - a).length());
+                acc
+            },
+        )
+        .reduce(|| [Moments::default(); N], |x, y| std::array::from_fn(|k| x[k].merge(y[k])))
 }
 
 /// Finds the canonical frame of `mesh` (a cleaned body), honouring `options`.
 pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, FrameError> {
-    let points: Vec<(DVec3, f64)> = (0..mesh.triangles.len())
-        .map(|t| {
-            let [a, b, c] = mesh.corners(t);
-            ((a + b + c) / 3.0, mesh.triangle_area(t))
-        })
-        .collect();
     let bounds = mesh.bounds().unwrap_or(crate::mesh::Aabb { min: DVec3::ZERO, max: DVec3::ZERO });
-
-    let up = options.up.unwrap_or_else(|| {
-        let axis = bounds.size().max_position();
-        let centroid = mean(points.iter().copied()).unwrap_or(bounds.min);
-        let mid = 0.5 * (bounds.min[axis] + bounds.max[axis]);
-        Direction { axis, negative: centroid[axis] < mid }
-    });
+    let up = match options.up {
+        Some(up) => up,
+        None => {
+            let axis = bounds.size().max_position();
+            let [all] = accumulate(mesh, |m: &mut [Moments; 1], p, a| m[0].add(p, a, DVec2::ZERO));
+            let centroid = all.mean().unwrap_or(bounds.min);
+            Direction {
+                axis,
+                negative: centroid[axis] < 0.5 * (bounds.min[axis] + bounds.max[axis]),
+            }
+        }
+    };
     let u = up.vector();
-    let heights = mesh.positions.iter().map(|p| p.dot(u));
-    let (floor, top) =
-        heights.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| (lo.min(h), hi.max(h)));
+    let (floor, top) = mesh
+        .positions
+        .iter()
+        .map(|p| p.dot(u))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| (lo.min(h), hi.max(h)));
     let height = top - floor;
     let units = match options.units {
         Some(units) => units,
         None => Units::from_height(height).ok_or(FrameError::UnknownUnits { height, up })?,
     };
-    let samples = Samples { points, up: u, floor, height };
 
-    // Horizontal coordinates on the two other axes.
+    // Horizontal coordinates on the two other axes; bands by fraction of the height:
+    // trunk (hips to shoulders), feet, shins.
     let e1 = Direction { axis: (up.axis + 1) % 3, negative: false }.vector();
     let e2 = Direction { axis: (up.axis + 2) % 3, negative: false }.vector();
     let flat = |p: DVec3| DVec2::new(p.dot(e1), p.dot(e2));
-    let trunk = || samples.band(0.45, 0.75);
-    let centre = mean(trunk()).unwrap_or(bounds.min);
+    let [trunk, feet, shins] = accumulate(mesh, |m: &mut [Moments; 3], p, a| {
+        let f = (p.dot(u) - floor) / height;
+        let band = match f {
+            _ if (0.45..=0.75).contains(&f) => 0,
+            _ if f <= 0.04 => 1,
+            _ if (0.10..=0.25).contains(&f) => 2,
+            _ => return,
+        };
+        m[band].add(p, a, flat(p));
+    });
+    let centre = trunk.mean().unwrap_or(bounds.min);
     let c2 = flat(centre);
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for (p, a) in trunk() {
-        let d = flat(p) - c2;
-        sxx += a * d.x * d.x;
-        sxy += a * d.x * d.y;
-        syy += a * d.y * d.y;
-    }
+    let w = trunk.weight.max(f64::MIN_POSITIVE);
+    let (sxx, sxy, syy) =
+        (trunk.xx / w - c2.x * c2.x, trunk.xy / w - c2.x * c2.y, trunk.yy / w - c2.y * c2.y);
     let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
     let front_back = DVec2::new(-theta.sin(), theta.cos());
-
-    let feet = mean(samples.band(0.0, 0.04)).map(flat);
-    let shins = mean(samples.band(0.10, 0.25)).map(flat);
-    let evidence = match (feet, shins) {
-        (Some(f), Some(s)) => (f - s).dot(front_back),
+    let evidence = match (feet.mean(), shins.mean()) {
+        (Some(f), Some(s)) => (flat(f) - flat(s)).dot(front_back),
         _ => 0.0,
     };
     let (facing, facing_detected) = match options.facing {

@@ -9,6 +9,7 @@
 use super::{Contour, Section};
 use crate::mesh::Mesh;
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 
 /// One triangle's piece of one plane: from `start` on edge `from` to `end` on edge `to`.
 #[derive(Debug, Clone, Copy)]
@@ -56,43 +57,61 @@ fn segment(mesh: &Mesh, tri: [u32; 3], h: f64) -> Segment {
 
 /// Cross-sections of `mesh` at each of `heights` (any order; returned in the same order).
 pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
+    sections_among(mesh, &mesh.triangles, heights)
+}
+
+/// Cross-sections of the surface made of `triangles` (indices into `mesh.positions`) only:
+/// for repeated cuts near one height, pass just the triangles there.
+pub fn sections_among(mesh: &Mesh, triangles: &[[u32; 3]], heights: &[f64]) -> Vec<Section> {
     let mut order: Vec<usize> = (0..heights.len()).collect();
     order.sort_by(|&a, &b| heights[a].total_cmp(&heights[b]));
     let sorted: Vec<f64> = order.iter().map(|&i| heights[i]).collect();
 
     // Planes crossed by each triangle: zmin < h <= zmax (a vertex on the plane counts as above).
-    let ranges: Vec<(usize, usize)> = mesh
-        .triangles
-        .iter()
+    let ranges: Vec<(u32, u32)> = triangles
+        .par_iter()
         .map(|tri| {
             let z = tri.map(|v| mesh.positions[v as usize].z);
             let (lo, hi) = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
-            (sorted.partition_point(|&h| h <= lo), sorted.partition_point(|&h| h <= hi))
+            (
+                sorted.partition_point(|&h| h <= lo) as u32,
+                sorted.partition_point(|&h| h <= hi) as u32,
+            )
         })
         .collect();
+    // The triangles of each plane, grouped by a counting sort.
     let mut offsets = vec![0usize; sorted.len() + 1];
     for &(lo, hi) in &ranges {
         for k in lo..hi {
-            offsets[k + 1] += 1;
+            offsets[k as usize + 1] += 1;
         }
     }
     for k in 0..sorted.len() {
         offsets[k + 1] += offsets[k];
     }
     let mut fill = offsets.clone();
-    let placeholder = Segment { from: 0, to: 0, start: DVec2::ZERO, end: DVec2::ZERO };
-    let mut segments = vec![placeholder; offsets[sorted.len()]];
-    for (tri, &(lo, hi)) in mesh.triangles.iter().zip(&ranges) {
-        for k in lo..hi {
-            segments[fill[k]] = segment(mesh, *tri, sorted[k]);
+    let mut crossing = vec![0u32; offsets[sorted.len()]];
+    for (t, &(lo, hi)) in ranges.iter().enumerate() {
+        for k in lo as usize..hi as usize {
+            crossing[fill[k]] = t as u32;
             fill[k] += 1;
         }
     }
 
+    let by_plane: Vec<Section> = (0..sorted.len())
+        .into_par_iter()
+        .map(|k| {
+            let h = sorted[k];
+            let mut segments: Vec<Segment> = crossing[offsets[k]..offsets[k + 1]]
+                .iter()
+                .map(|&t| segment(mesh, triangles[t as usize], h))
+                .collect();
+            chain(&mut segments, h)
+        })
+        .collect();
     let mut out: Vec<Option<Section>> = vec![None; heights.len()];
-    for (k, &i) in order.iter().enumerate() {
-        let plane = &mut segments[offsets[k]..offsets[k + 1]];
-        out[i] = Some(chain(plane, sorted[k]));
+    for (section, &i) in by_plane.into_iter().zip(&order) {
+        out[i] = Some(section);
     }
     out.into_iter().flatten().collect()
 }

@@ -7,6 +7,7 @@
 
 mod obj;
 mod ply;
+mod ply_binary;
 mod stl;
 
 use crate::mesh::Mesh;

@@ -150,6 +150,22 @@ pub(super) fn read(bytes: &[u8]) -> Result<Mesh, ReadError> {
     };
     let mut reader = Reader::new(bytes);
     let header = Parser::<PlyVertex>::new().read_header(&mut reader).map_err(malformed)?;
+    let element_names: Vec<&str> = header.elements.values().map(|e| e.name.as_str()).collect();
+    if !element_names.contains(&"vertex") || !element_names.contains(&"face") {
+        return Err(ReadError::Malformed(format!(
+            "expected vertex and face elements, found {element_names:?}"
+        )));
+    }
+    if element_names.iter().position(|&n| n == "face")
+        < element_names.iter().position(|&n| n == "vertex")
+    {
+        return Err(ReadError::Malformed("faces come before vertices".into()));
+    }
+    let payload = reader.into_inner();
+    if let Some(mesh) = super::ply_binary::read(payload, &header) {
+        return mesh;
+    }
+    let mut reader = Reader::new(payload);
     let mut vertices = Vec::new();
     let mut faces = Vec::new();
     for element in header.elements.values() {
