@@ -1,0 +1,194 @@
+//! Actuators of a node, sets of them, and positions along their stroke.
+//!
+//! A node drives at most [`MAX_ACTUATORS`] (8) linear actuators, numbered 0..=7. A board with
+//! more actuators presents itself as several nodes (as ODrive does with its two axes).
+//!
+//! Positions are `u16` in **0.01 mm**, measured from the actuator's home (fully retracted) end
+//! outwards, so 0..=655.34 mm; the wire value `0xFFFF` is reserved and means "no position"
+//! ("keep the staged target" in set-points, "unknown, not homed" in feedback). In Rust that is
+//! an `Option<Position>`.
+
+/// The most actuators one node drives.
+pub const MAX_ACTUATORS: usize = 8;
+
+/// The wire value of "no position" (`None`).
+pub(crate) const NO_POSITION: u16 = 0xFFFF;
+
+/// One actuator of a node, by index 0..=7.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Actuator(u8);
+
+impl Actuator {
+    /// The actuator with this index, if it is below [`MAX_ACTUATORS`].
+    pub const fn new(index: u8) -> Option<Self> {
+        if (index as usize) < MAX_ACTUATORS { Some(Self(index)) } else { None }
+    }
+
+    /// The index, 0..=7.
+    pub const fn index(self) -> usize {
+        self.0 as usize
+    }
+
+    /// Every actuator a node can have, 0..=7.
+    pub fn all() -> impl Iterator<Item = Actuator> {
+        (0..MAX_ACTUATORS as u8).map(Actuator)
+    }
+}
+
+/// The wire value of an "actuator or the whole node" field: 0..=7, or 0xFF for the node.
+pub(crate) const fn actuator_to_wire(actuator: Option<Actuator>) -> u8 {
+    match actuator {
+        Some(a) => a.0,
+        None => 0xFF,
+    }
+}
+
+/// Decodes an "actuator or the whole node" field; `Err(())` for 8..=0xFE.
+pub(crate) const fn actuator_from_wire(raw: u8) -> Result<Option<Actuator>, ()> {
+    match raw {
+        0xFF => Ok(None),
+        _ => match Actuator::new(raw) {
+            Some(a) => Ok(Some(a)),
+            None => Err(()),
+        },
+    }
+}
+
+/// A set of a node's actuators, as a bit mask: bit `i` is actuator `i`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct ActuatorSet(u8);
+
+impl ActuatorSet {
+    /// No actuator.
+    pub const EMPTY: Self = Self(0);
+    /// All eight actuators (bits a node does not have are ignored by it).
+    pub const ALL: Self = Self(0xFF);
+
+    /// The set with this bit mask.
+    pub const fn from_bits(bits: u8) -> Self {
+        Self(bits)
+    }
+
+    /// The bit mask.
+    pub const fn bits(self) -> u8 {
+        self.0
+    }
+
+    /// Whether the set holds no actuator.
+    pub const fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// Whether `actuator` is in the set.
+    pub const fn contains(self, actuator: Actuator) -> bool {
+        self.0 & (1 << actuator.0) != 0
+    }
+
+    /// The set with `actuator` added.
+    pub const fn with(self, actuator: Actuator) -> Self {
+        Self(self.0 | 1 << actuator.0)
+    }
+
+    /// The actuators in the set, lowest index first.
+    pub fn iter(self) -> impl Iterator<Item = Actuator> {
+        Actuator::all().filter(move |&a| self.contains(a))
+    }
+}
+
+impl FromIterator<Actuator> for ActuatorSet {
+    fn from_iter<I: IntoIterator<Item = Actuator>>(iter: I) -> Self {
+        iter.into_iter().fold(Self::EMPTY, Self::with)
+    }
+}
+
+/// A position along an actuator's stroke: 0.01 mm from its home end, at most 655.34 mm.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Position(u16);
+
+impl Position {
+    /// The home (fully retracted) end of the stroke.
+    pub const ZERO: Self = Self(0);
+    /// The largest position the wire can carry, 655.34 mm.
+    pub const MAX: Self = Self(NO_POSITION - 1);
+
+    /// The position `hundredths_mm` × 0.01 mm, if at most [`Position::MAX`].
+    pub const fn new(hundredths_mm: u16) -> Option<Self> {
+        if hundredths_mm == NO_POSITION { None } else { Some(Self(hundredths_mm)) }
+    }
+
+    /// The position rounded to 0.01 mm, if `mm` is a number in 0..=655.34.
+    pub fn from_mm(mm: f32) -> Option<Self> {
+        let hundredths = mm * 100.0 + 0.5;
+        // The negated comparison also rejects NaN.
+        if !(0.0..(NO_POSITION as f32)).contains(&hundredths) {
+            return None;
+        }
+        Some(Self(hundredths as u16))
+    }
+
+    /// The position in 0.01 mm.
+    pub const fn hundredths_mm(self) -> u16 {
+        self.0
+    }
+
+    /// The position in millimetres.
+    pub fn mm(self) -> f32 {
+        f32::from(self.0) / 100.0
+    }
+}
+
+/// The wire value of a position slot.
+pub(crate) const fn position_to_wire(position: Option<Position>) -> u16 {
+    match position {
+        Some(p) => p.0,
+        None => NO_POSITION,
+    }
+}
+
+/// Decodes a position slot; every `u16` is valid.
+pub(crate) const fn position_from_wire(raw: u16) -> Option<Position> {
+    Position::new(raw)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn actuator_indices_stop_at_eight() {
+        assert_eq!(Actuator::new(7).map(Actuator::index), Some(7));
+        assert_eq!(Actuator::new(8), None);
+        assert_eq!(Actuator::all().count(), MAX_ACTUATORS);
+    }
+
+    #[test]
+    fn node_wide_actuator_field_is_0xff_and_8_to_0xfe_are_invalid() {
+        assert_eq!(actuator_to_wire(None), 0xFF);
+        assert_eq!(actuator_from_wire(0xFF), Ok(None));
+        assert_eq!(actuator_from_wire(3), Ok(Actuator::new(3)));
+        assert!((8..=0xFE).all(|raw| actuator_from_wire(raw).is_err()));
+    }
+
+    #[test]
+    fn actuator_sets_are_bit_masks() {
+        let set: ActuatorSet = [1, 6].into_iter().filter_map(Actuator::new).collect();
+        assert_eq!(set.bits(), 0b0100_0010);
+        assert!(set.contains(Actuator::new(6).unwrap()));
+        assert!(!set.contains(Actuator::new(0).unwrap()));
+        assert_eq!(set.iter().map(Actuator::index).collect::<Vec<_>>(), [1, 6]);
+        assert!(ActuatorSet::EMPTY.is_empty() && !ActuatorSet::ALL.is_empty());
+    }
+
+    #[test]
+    fn positions_round_to_hundredths_and_reserve_0xffff() {
+        assert_eq!(Position::from_mm(12.345).map(Position::hundredths_mm), Some(1235));
+        assert_eq!(Position::from_mm(0.0), Some(Position::ZERO));
+        assert_eq!(Position::from_mm(655.34), Some(Position::MAX));
+        assert_eq!(Position::from_mm(655.35), None);
+        assert_eq!(Position::from_mm(-0.01), None);
+        assert_eq!(Position::from_mm(f32::NAN), None);
+        assert_eq!(Position::new(0xFFFF), None);
+        assert_eq!(position_from_wire(position_to_wire(None)), None);
+        assert!((Position::new(2550).unwrap().mm() - 25.5).abs() < 1e-6);
+    }
+}
