@@ -75,9 +75,13 @@ impl Mesh {
         (0..self.triangles.len()).map(|t| self.triangle_area(t)).sum()
     }
 
-    /// Bounding box of the vertices used by triangles, or `None` for a mesh without triangles.
+    /// Bounding box of the vertices, or `None` for a mesh without triangles. (Unused vertices
+    /// count too; meshes from [`crate::scan`] have none.)
     pub fn bounds(&self) -> Option<Aabb> {
-        Aabb::around(self.triangles.iter().flatten().map(|&i| self.positions[i as usize]))
+        if self.triangles.is_empty() {
+            return None;
+        }
+        Aabb::around(self.positions.iter().copied())
     }
 
     /// Signed volume enclosed (positive for a closed, outward-oriented mesh).
@@ -95,6 +99,13 @@ impl Mesh {
         Mesh {
             positions: self.positions.iter().map(|&p| f(p)).collect(),
             triangles: self.triangles.clone(),
+        }
+    }
+
+    /// Maps every position by `f` in place.
+    pub fn transform(&mut self, f: impl Fn(DVec3) -> DVec3) {
+        for p in &mut self.positions {
+            *p = f(*p);
         }
     }
 

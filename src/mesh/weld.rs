@@ -10,14 +10,18 @@ use rayon::prelude::*;
 /// of them; returns how many were merged away. Vertices no triangle uses are dropped too.
 /// A parallel sort of the positions' bit patterns finds the duplicates.
 pub(super) fn weld_identical(mesh: &mut Mesh) -> usize {
-    let key = |i: u32| mesh.positions[i as usize].to_array().map(|c| (c + 0.0).to_bits());
-    let mut order: Vec<u32> = (0..mesh.positions.len() as u32).collect();
-    order.par_sort_unstable_by_key(|&i| (key(i), i));
+    let mut keyed: Vec<([u64; 3], u32)> = mesh
+        .positions
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| (p.to_array().map(|c| (c + 0.0).to_bits()), i as u32))
+        .collect();
+    keyed.par_sort_unstable();
     let mut remap: Vec<u32> = (0..mesh.positions.len() as u32).collect();
     let mut merged = 0;
-    for run in order.chunk_by(|&a, &b| key(a) == key(b)) {
-        for &i in &run[1..] {
-            remap[i as usize] = run[0];
+    for run in keyed.chunk_by(|a, b| a.0 == b.0) {
+        for &(_, i) in &run[1..] {
+            remap[i as usize] = run[0].1;
             merged += 1;
         }
     }

@@ -102,11 +102,11 @@ pub fn load(path: &Path, options: &FrameOptions) -> Result<Scan, ScanError> {
 /// names it in messages.
 pub fn from_mesh(mesh: Mesh, source: &Path, options: &FrameOptions) -> Result<Scan, ScanError> {
     let (raw_vertices, raw_triangles) = (mesh.positions.len(), mesh.triangles.len());
-    let (body, cleaning) =
+    let (mut body, cleaning) =
         clean::clean(mesh).map_err(|error| ScanError::Clean { path: source.into(), error })?;
     let frame = frame::detect(&body, options)
         .map_err(|error| ScanError::Frame { path: source.into(), error })?;
-    let body = body.map_positions(|p| frame.to_canonical(p));
+    body.transform(|p| frame.to_canonical(p));
     Ok(Scan { source: source.into(), raw_vertices, raw_triangles, cleaning, frame, body })
 }
 

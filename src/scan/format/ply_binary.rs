@@ -92,6 +92,22 @@ impl Cursor<'_> {
         })
     }
 
+    /// Reads one integer of type `t` (a list count or a vertex index); a float type is a
+    /// malformed index list.
+    fn integer(&mut self, t: Num) -> Result<i64, ReadError> {
+        Ok(match t {
+            Num::I8 => i8::from_le_bytes(self.take()?).into(),
+            Num::U8 => u8::from_le_bytes(self.take()?).into(),
+            Num::I16 => i16::from_le_bytes(self.take()?).into(),
+            Num::U16 => u16::from_le_bytes(self.take()?).into(),
+            Num::I32 => i32::from_le_bytes(self.take()?).into(),
+            Num::U32 => u32::from_le_bytes(self.take()?).into(),
+            Num::F32 | Num::F64 => {
+                return Err(ReadError::Malformed("vertex indices must be integers".into()));
+            }
+        })
+    }
+
     fn skip(&mut self, n: usize) -> Result<(), ReadError> {
         let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len()).ok_or_else(|| {
             ReadError::Truncated(format!(
@@ -191,29 +207,36 @@ fn decode(cursor: &mut Cursor, header: &Header, layouts: &[Layout]) -> Result<Me
                 cursor.skip(element.count.checked_mul(*stride).unwrap_or(usize::MAX))?;
             }
             (_, Layout::Face(types, list)) => {
+                let vertices = positions.len();
                 let mut polygon = Vec::new();
+                triangles.reserve(element.count);
                 for face in 0..element.count {
                     for (k, t) in types.iter().enumerate() {
                         match *t {
                             Property::Scalar(s) => cursor.skip(s.size())?,
                             Property::List(count_type, index_type) => {
-                                let count = cursor.number(count_type)?;
+                                let count = cursor.integer(count_type)?.max(0) as usize;
                                 polygon.clear();
-                                for _ in 0..count.max(0.0) as usize {
-                                    let index = cursor.number(index_type)?;
+                                for _ in 0..count {
+                                    let index = cursor.integer(index_type)?;
                                     if k != *list {
                                         continue;
                                     }
-                                    if index < 0.0 || index >= positions.len() as f64 {
-                                        return Err(ReadError::IndexOutOfRange {
-                                            face,
-                                            index: index as i64,
-                                            vertices: positions.len(),
-                                        });
+                                    match u32::try_from(index) {
+                                        Ok(i) if (i as usize) < vertices => polygon.push(i),
+                                        _ => {
+                                            return Err(ReadError::IndexOutOfRange {
+                                                face,
+                                                index,
+                                                vertices,
+                                            });
+                                        }
                                     }
-                                    polygon.push(index as u32);
                                 }
-                                fan(&polygon, &mut triangles);
+                                match polygon[..] {
+                                    [a, b, c] => triangles.push([a, b, c]),
+                                    _ => fan(&polygon, &mut triangles),
+                                }
                             }
                         }
                     }

@@ -1,0 +1,113 @@
+//! Benchmarks of the scan side on the realistic MakeHuman body, subdivided to scanner
+//! density: slicing alone, the full `symmetrize`, and the whole `dressform slice` process.
+//!
+//! `cargo bench --bench pipeline`; needs `../shared/makehuman` (or `$DRESSFORM_MAKEHUMAN`).
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use dressform::mannequin::MannequinOptions;
+use dressform::mesh::Mesh;
+use dressform::pipeline::symmetrize;
+use dressform::scan::format::Format;
+use dressform::scan::{self, frame::FrameOptions};
+use dressform::slice::sections;
+use glam::DVec3;
+use std::path::PathBuf;
+use std::time::Duration;
+
+fn makehuman() -> Option<PathBuf> {
+    let dir = std::env::var_os("DRESSFORM_MAKEHUMAN")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/makehuman"));
+    dir.join("base.obj").is_file().then_some(dir)
+}
+
+/// Splits every triangle into `k * k` (points summed in vertex-index order, so that both
+/// triangles along an edge create bit-identical points and the result welds watertight).
+fn subdivide(m: &Mesh, k: u32) -> Mesh {
+    let mut out = Mesh::default();
+    for tri in &m.triangles {
+        let mut rows: Vec<Vec<u32>> = Vec::new();
+        for i in 0..=k {
+            let mut row = Vec::new();
+            for j in 0..=k - i {
+                let weights = [k - i - j, i, j];
+                let mut terms: Vec<(u32, u32)> = (0..3).map(|c| (tri[c], weights[c])).collect();
+                terms.sort_unstable();
+                let p = terms.iter().fold(DVec3::ZERO, |acc, &(v, w)| {
+                    acc + m.positions[v as usize] * (w as f64 / k as f64)
+                });
+                row.push(out.positions.len() as u32);
+                out.positions.push(p);
+            }
+            rows.push(row);
+        }
+        for i in 0..k as usize {
+            for j in 0..k as usize - i {
+                out.triangles.push([rows[i][j], rows[i + 1][j], rows[i][j + 1]]);
+                if j + 1 < k as usize - i {
+                    out.triangles.push([rows[i + 1][j], rows[i + 1][j + 1], rows[i][j + 1]]);
+                }
+            }
+        }
+    }
+    out.weld_identical();
+    out
+}
+
+fn planes(height: f64, n: usize) -> Vec<f64> {
+    (0..n).map(|i| height * (i as f64 + 0.5) / n as f64).collect()
+}
+
+fn benches(c: &mut Criterion) {
+    let Some(dir) = makehuman() else {
+        eprintln!("SKIPPED: MakeHuman assets not found (set DRESSFORM_MAKEHUMAN)");
+        return;
+    };
+    let base = scan::load(&dir.join("base.obj"), &FrameOptions::default())
+        .expect("the MakeHuman body loads");
+    let body = subdivide(&base.body, 4);
+    let height = base.frame.height_mm;
+    let heights = planes(height, 200);
+    let mut group = c.benchmark_group("scan");
+    group.sample_size(20);
+    group.bench_function(format!("slice {} triangles at 200 planes", body.triangles.len()), |b| {
+        b.iter(|| sections(&body, &heights))
+    });
+
+    let dense = scan::from_mesh(body, &dir.join("base.obj"), &FrameOptions::default())
+        .expect("subdivided body");
+    group.bench_function(format!("symmetrize {} triangles", dense.body.triangles.len()), |b| {
+        b.iter(|| symmetrize(&dense, &MannequinOptions::default(), |_| {}).expect("symmetrize"))
+    });
+
+    // The whole process on a binary PLY of about a million triangles, in the file's units.
+    let million = subdivide(&base.body, 6).map_positions(|p| base.frame.to_scan(p));
+    let tmp = tempfile::tempdir().expect("temporary directory");
+    let ply = tmp.path().join("scan.ply");
+    std::fs::write(&ply, Format::Ply.encode(&million)).expect("write the PLY");
+    let list: Vec<String> = planes(height, 200).iter().map(|h| format!("{h:.2}")).collect();
+    let list = list.join(",");
+    group.measurement_time(Duration::from_secs(10));
+    group.bench_function(
+        format!("dressform slice process, {} triangles, 200 planes", million.triangles.len()),
+        |b| {
+            b.iter(|| {
+                let out = std::process::Command::new(env!("CARGO_BIN_EXE_dressform"))
+                    .args([
+                        "slice",
+                        ply.to_str().expect("utf-8 path"),
+                        "--heights",
+                        &list,
+                        "--json",
+                    ])
+                    .output()
+                    .expect("dressform runs");
+                assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+            })
+        },
+    );
+    group.finish();
+}
+
+criterion_group!(pipeline, benches);
+criterion_main!(pipeline);
