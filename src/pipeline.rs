@@ -2,7 +2,7 @@
 //! measure both. Used by `symmetrize`, and by `run` and `demo`.
 
 use crate::mannequin::{self, Mannequin, MannequinError, MannequinOptions};
-use crate::measure::{Comparison, compare};
+use crate::measure::{Comparison, compare, levels};
 use crate::regions::{BodyRegions, TRACKING_STEP_MM};
 use crate::scan::Scan;
 
@@ -30,8 +30,10 @@ pub fn symmetrize(
     progress(0);
     let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM)?;
     progress(1);
-    let mannequin = mannequin::build(&scan.body, &regions, options)?;
+    let levels = levels(&scan.body, &regions);
+    let mannequin =
+        mannequin::build(&scan.body, &regions, &[levels.chest, levels.waist, levels.hip], options)?;
     progress(2);
-    let comparison = compare(&scan.body, &regions, &mannequin);
+    let comparison = compare(&scan.body, &regions, &levels, &mannequin);
     Ok(Symmetrized { regions, mannequin, comparison })
 }

@@ -7,7 +7,7 @@
 //!   "axis_x": 0.0,                    // the symmetry plane x = axis_x
 //!   "rays": 360, "preserve": "tape",
 //!   "landmarks": { "height": .., "crotch": .., "ankle": .., "left_armpit": .., "right_armpit": ..,
-//!                  "neck": .., "arm_cut": .. },
+//!                  "neck": .., "centre_x": .., "arm_cut": .. },
 //!   "layers": [                       // legs (left, right), then torso; each bottom to top
 //!     { "region": "torso" | "left_leg" | "right_leg",
 //!       "z": 812.5, "centre": [x, y],

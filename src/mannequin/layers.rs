@@ -38,14 +38,25 @@ pub(super) struct SymmetricLayers {
     pub right_leg: Vec<Layer>,
 }
 
-/// The symmetry axis and the symmetric torso, left-leg and right-leg layers.
+/// The symmetry axis and the symmetric torso, left-leg and right-leg layers; the torso layers
+/// nearest to `keep` heights (the measurement levels) are moved onto them.
 pub(super) fn symmetric_layers(
     body: &Mesh,
     regions: &BodyRegions,
+    keep: &[f64],
     o: &MannequinOptions,
 ) -> Result<SymmetricLayers, MannequinError> {
     let m = &regions.landmarks;
-    let torso_z = spaced(m.crotch + CROTCH_CLEARANCE_MM, m.neck, o.torso_layers);
+    let mut torso_z = spaced(m.crotch + CROTCH_CLEARANCE_MM, m.neck, o.torso_layers);
+    let inner = 1..torso_z.len() - 1;
+    for &z in keep {
+        let nearest = inner
+            .clone()
+            .min_by(|&a, &b| (torso_z[a] - z).abs().total_cmp(&(torso_z[b] - z).abs()));
+        if let Some(k) = nearest.filter(|&k| z > torso_z[k - 1] && z < torso_z[k + 1]) {
+            torso_z[k] = z;
+        }
+    }
     let leg_z = spaced(m.ankle, m.crotch - CROTCH_CLEARANCE_MM, o.leg_layers);
 
     // Torso sections, with the arms cut off above the armpits.

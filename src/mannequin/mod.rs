@@ -3,7 +3,7 @@
 //!
 //! Layers (defaults from the paper): 100 torso layers from just above the crotch to the neck,
 //! 50 leg layers from the ankles to just below the crotch. Above the armpits the torso sections
-//! are cut at x = ±`arm_cut` (vertical arm plates, as on a dress form), so the arms are not part
+//! are cut at x = `centre_x` ± `arm_cut` (vertical arm plates, as on a dress form), so the arms are not part
 //! of the torso. All layers share one symmetry plane, x = `axis`: the median of the torso
 //! sections' bounding-box centres.
 
@@ -107,10 +107,13 @@ pub enum MannequinError {
     },
 }
 
-/// Builds the symmetric mannequin of `body` (canonical frame) segmented as `regions`.
+/// Builds the symmetric mannequin of `body` (canonical frame) segmented as `regions`, with a
+/// torso layer exactly at each of the `keep` heights (the chest, waist and hip levels, so that
+/// the mannequin keeps exactly the girths a tailor measures).
 pub fn build(
     body: &Mesh,
     regions: &BodyRegions,
+    keep: &[f64],
     options: &MannequinOptions,
 ) -> Result<Mannequin, MannequinError> {
     if options.torso_layers < 2 || options.leg_layers < 2 {
@@ -121,7 +124,7 @@ pub fn build(
     }
     crate::symmetry::check_rays(options.rays)?;
     let layers::SymmetricLayers { axis, torso, left_leg, right_leg } =
-        layers::symmetric_layers(body, regions, options)?;
+        layers::symmetric_layers(body, regions, keep, options)?;
     let mesh = rebuild::rebuild(&torso, &left_leg, &right_leg, axis);
     Ok(Mannequin {
         axis,

@@ -74,9 +74,15 @@ fn width(c: &Contour) -> f64 {
     hi - lo
 }
 
-/// Compares `body` (with its `regions`) and its `mannequin` at the body's measurement levels.
-pub fn compare(body: &Mesh, regions: &BodyRegions, mannequin: &Mannequin) -> Comparison {
-    let levels = super::levels(body, regions);
+/// Compares `body` (with its `regions`) and its `mannequin` at the body's measurement
+/// `levels`.
+pub fn compare(
+    body: &Mesh,
+    regions: &BodyRegions,
+    levels: &Levels,
+    mannequin: &Mannequin,
+) -> Comparison {
+    let levels = *levels;
     let input = measure_at(body, regions, &levels);
     let zs = [levels.chest, levels.waist, levels.hip];
     let central = central_loops(&mannequin.mesh, mannequin.axis, &zs);

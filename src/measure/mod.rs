@@ -10,7 +10,9 @@
 //!   the chest level; where that band has no narrowest point inside it (a round belly), the
 //!   level 55% of the way. (ISO 8559-1 puts the waist midway between the lowest rib and the
 //!   iliac crest; a scan has neither landmark, so the narrowing is the evidence used.)
-//! - **height**: the body's extent along Z; **crotch height**: the crotch landmark.
+//! - **height** (stature): floor to crown, from the heights of the vertices averaged with
+//!   their neighbours (so one noisy vertex of a scan does not set it); **crotch height**: the
+//!   crotch landmark.
 //!
 //! The mannequin is measured at the same levels: it lives in the same frame, so a height on it
 //! is the same height on the input.
@@ -109,12 +111,30 @@ pub fn measure_at(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> Measur
             .map_or(Girth { z: zs[k], tape: 0.0, contour: 0.0 }, |c| Girth::of(zs[k], c))
     };
     Measurements {
-        height: regions.landmarks.height,
+        height: stature(body),
         crotch_height: regions.landmarks.crotch,
         chest: girth(0),
         waist: girth(1),
         hip: girth(2),
     }
+}
+
+/// Floor-to-crown height of `body`: the extremes of its vertex heights after averaging each
+/// with its neighbours' (one pass over the triangles).
+pub fn stature(body: &Mesh) -> f64 {
+    let mut sum = vec![0.0; body.positions.len()];
+    let mut count = vec![0u32; body.positions.len()];
+    for tri in &body.triangles {
+        let z: f64 = tri.iter().map(|&v| body.positions[v as usize].z).sum();
+        for &v in tri {
+            sum[v as usize] += z;
+            count[v as usize] += 3;
+        }
+    }
+    let smoothed = sum.iter().zip(&count).filter(|&(_, &n)| n > 0).map(|(s, &n)| s / f64::from(n));
+    let (lo, hi) =
+        smoothed.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| (lo.min(z), hi.max(z)));
+    hi - lo
 }
 
 /// The loop around the symmetry plane x = `axis` at each height, for a mesh with no arms or

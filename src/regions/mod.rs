@@ -48,8 +48,11 @@ pub struct Landmarks {
     pub right_armpit: f64,
     /// The narrowest torso level between the armpits and the head.
     pub neck: f64,
-    /// Half-width (|x|) of the torso just below the armpits: the vertical planes x = ±this cut
-    /// the arms off the torso sections above the armpits, like a dress form's arm plates.
+    /// The torso's centre line: its bounding-box centre (x) just below the armpits.
+    pub centre_x: f64,
+    /// Half-width of the torso just below the armpits: the vertical planes
+    /// x = `centre_x` ± `arm_cut` cut the arms off the torso sections above the armpits, like a
+    /// dress form's arm plates.
     pub arm_cut: f64,
 }
 
@@ -57,6 +60,15 @@ impl Landmarks {
     /// The higher of the two armpits: above it, no section holds a separate arm.
     pub fn armpit(&self) -> f64 {
         self.left_armpit.max(self.right_armpit)
+    }
+
+    /// Which of the bands between the crotch, the armpits and the neck `z` lies in: the
+    /// number of those landmarks at or below it.
+    fn band(&self, z: f64) -> usize {
+        [self.crotch, self.left_armpit, self.right_armpit, self.neck]
+            .iter()
+            .filter(|&&h| h <= z)
+            .count()
     }
 }
 
@@ -112,8 +124,8 @@ impl BodyRegions {
     }
 
     /// The torso's section at each of `heights` (`None` where there is none): the largest
-    /// loop labelled torso (at and above the neck, head), with the arms cut off at
-    /// x = ±`arm_cut` above the armpits.
+    /// loop labelled torso (at and above the neck, head), with each arm cut off at
+    /// x = `centre_x` ± `arm_cut` above its armpit.
     pub fn torso_sections(&self, body: &Mesh, heights: &[f64]) -> Vec<Option<Contour>> {
         let m = &self.landmarks;
         sections(body, heights)
@@ -122,19 +134,36 @@ impl BodyRegions {
                 let labels = self.label(&s);
                 let found = largest_with(&s, &labels, Region::Torso)
                     .or_else(|| largest_with(&s, &labels, Region::Head));
+                let lo = if s.height > m.right_armpit {
+                    m.centre_x - m.arm_cut
+                } else {
+                    f64::NEG_INFINITY
+                };
+                let hi =
+                    if s.height > m.left_armpit { m.centre_x + m.arm_cut } else { f64::INFINITY };
                 found.map(|c| {
-                    if s.height > m.armpit() { c.clip_x(-m.arm_cut, m.arm_cut) } else { c.clone() }
+                    if lo.is_finite() || hi.is_finite() { c.clip_x(lo, hi) } else { c.clone() }
                 })
             })
             .collect()
     }
 
     /// Labels for the loops of `section` (cut from the same body at any height): each loop
-    /// takes the label of the tracked loop at the nearest level that holds its centroid (or,
-    /// failing that, the nearest tracked centroid).
+    /// takes the label of the tracked loop that holds its centroid (or, failing that, the
+    /// nearest tracked centroid) at the nearest tracked level between the same landmarks, so
+    /// that a cut just below the crotch or an armpit is never labelled from a level above it.
     pub fn label(&self, section: &Section) -> Vec<Region> {
-        let i = ((section.height - self.levels[0].section.height) / self.step).round();
-        let level = &self.levels[(i.max(0.0) as usize).min(self.levels.len() - 1)];
+        let z = section.height;
+        let band = self.landmarks.band(z);
+        let level = self
+            .levels
+            .iter()
+            .filter(|l| self.landmarks.band(l.section.height) == band)
+            .min_by(|a, b| (a.section.height - z).abs().total_cmp(&(b.section.height - z).abs()))
+            .unwrap_or_else(|| {
+                let i = ((z - self.levels[0].section.height) / self.step).round();
+                &self.levels[(i.max(0.0) as usize).min(self.levels.len() - 1)]
+            });
         section
             .loops
             .iter()
@@ -162,15 +191,15 @@ impl BodyRegions {
 fn fallback_region(c: DVec2, z: f64, m: &Landmarks) -> Region {
     match () {
         _ if z >= m.neck => Region::Head,
-        _ if z >= m.crotch && c.x.abs() <= m.arm_cut => Region::Torso,
-        _ if z >= m.crotch => side(c, Region::LeftArm, Region::RightArm),
-        _ => side(c, Region::LeftLeg, Region::RightLeg),
+        _ if z >= m.crotch && (c.x - m.centre_x).abs() <= m.arm_cut => Region::Torso,
+        _ if z >= m.crotch => side(c.x - m.centre_x, Region::LeftArm, Region::RightArm),
+        _ => side(c.x - m.centre_x, Region::LeftLeg, Region::RightLeg),
     }
 }
 
-/// `left` for a point on the subject's left (+X), else `right`.
-fn side(c: DVec2, left: Region, right: Region) -> Region {
-    if c.x >= 0.0 { left } else { right }
+/// `left` for a point `dx` to the subject's left (+X) of the centre line, else `right`.
+fn side(dx: f64, left: Region, right: Region) -> Region {
+    if dx >= 0.0 { left } else { right }
 }
 
 /// The largest loop of `section` labelled `region` (`labels` as from [`BodyRegions::label`]).

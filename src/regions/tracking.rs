@@ -121,8 +121,10 @@ pub(super) fn track(body: &Mesh, step: f64) -> Result<BodyRegions, RegionError> 
             .map(|w| (0.5 * (z_of(w[0].0) + z_of(w[1].0)), pick(&w[0])))
             .ok_or(RegionError::NoArm { side: name })
     };
-    let (left_armpit, left_cut) = armpit(|w| w.1, "left")?;
-    let (right_armpit, right_cut) = armpit(|w| w.2, "right")?;
+    // The arm planes go where the torso's sides were just below each armpit.
+    let (left_armpit, left_side) = armpit(|w| w.1, "left")?;
+    let (right_armpit, right_side) = armpit(|w| w.2, "right")?;
+    let centre_x = 0.5 * (left_side - right_side);
 
     // Neck: the narrowest torso level between the armpits and the head's widest level.
     let girth = |&(i, k): &(usize, usize)| sections[i].loops[k].tape_girth();
@@ -156,7 +158,8 @@ pub(super) fn track(body: &Mesh, step: f64) -> Result<BodyRegions, RegionError> 
         left_armpit,
         right_armpit,
         neck,
-        arm_cut: 0.5 * (left_cut + right_cut),
+        centre_x,
+        arm_cut: 0.5 * (left_side + right_side),
     };
 
     let levels = sections
@@ -177,7 +180,7 @@ pub(super) fn track(body: &Mesh, step: f64) -> Result<BodyRegions, RegionError> 
                     } else if z >= neck || head_loop.is_some_and(|h| h.contains(c)) {
                         Region::Head
                     } else {
-                        side(c, Region::LeftArm, Region::RightArm)
+                        side(c.x - centre_x, Region::LeftArm, Region::RightArm)
                     }
                 })
                 .collect();

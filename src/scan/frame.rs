@@ -1,6 +1,7 @@
 //! The canonical body frame: millimetres, Z up, floor at z = 0, +X = the subject's left, the
 //! subject facing -Y (right-handed, as in Blender's front view), origin under the torso's
-//! centre. Scans arrive in any unit, with Y or Z up and turned any way about the vertical; this
+//! centre: the bounding-box centre of the largest horizontal section at 58% of the height
+//! (the waist, which no arm pose moves). Scans arrive in any unit, with Y or Z up and turned any way about the vertical; this
 //! module finds out which, and keeps the transform so outputs can go back to the scan's frame.
 //!
 //! Detection, each step overridable:
@@ -15,7 +16,8 @@
 //! - **front**: the side the feet point to (the lowest 4% of the body lies in front of the
 //!   shins).
 
-use crate::mesh::Mesh;
+use crate::mesh::{Aabb, Mesh};
+use crate::slice::sections;
 use glam::{DMat3, DVec2, DVec3};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -190,6 +192,21 @@ impl CanonicalFrame {
     /// A canonical point back in the scan's frame.
     pub fn to_scan(&self, q: DVec3) -> DVec3 {
         self.rotation.transpose() * (q - self.translation) / self.units.mm()
+    }
+
+    /// Moves the origin under the torso of `body` (already in this frame): the bounding-box
+    /// centre of its largest section at 58% of the height. Updates `body` and the transform.
+    pub fn centre_on_torso(&mut self, body: &mut Mesh) {
+        let z = 0.58 * self.height_mm;
+        let Some(torso) =
+            sections(body, &[z]).into_iter().next().and_then(|s| s.loops.into_iter().next())
+        else {
+            return;
+        };
+        let Some(b) = Aabb::around(torso.points.iter().map(|p| p.extend(0.0))) else { return };
+        let shift = DVec3::new(0.5 * (b.min.x + b.max.x), 0.5 * (b.min.y + b.max.y), 0.0);
+        body.transform(|p| p - shift);
+        self.translation -= shift;
     }
 
     /// `facing` as an axis name when it is one (within 1 degree).

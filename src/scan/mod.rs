@@ -104,9 +104,10 @@ pub fn from_mesh(mesh: Mesh, source: &Path, options: &FrameOptions) -> Result<Sc
     let (raw_vertices, raw_triangles) = (mesh.positions.len(), mesh.triangles.len());
     let (mut body, cleaning) =
         clean::clean(mesh).map_err(|error| ScanError::Clean { path: source.into(), error })?;
-    let frame = frame::detect(&body, options)
+    let mut frame = frame::detect(&body, options)
         .map_err(|error| ScanError::Frame { path: source.into(), error })?;
     body.transform(|p| frame.to_canonical(p));
+    frame.centre_on_torso(&mut body);
     Ok(Scan { source: source.into(), raw_vertices, raw_triangles, cleaning, frame, body })
 }
 
