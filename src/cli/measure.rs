@@ -1,6 +1,6 @@
 //! `dressform measure <mesh> [--json] [--at z,...]`.
 
-use super::{Failure, FrameArgs, warn};
+use super::{Failure, FrameArgs, SmoothArgs, warn};
 use dressform::measure::{Girth, Levels, Measurements, levels, measure_at};
 use dressform::regions::{BodyRegions, Landmarks, TRACKING_STEP_MM};
 use dressform::scan;
@@ -19,6 +19,8 @@ pub struct MeasureArgs {
     json: bool,
     #[command(flatten)]
     frame: FrameArgs,
+    #[command(flatten)]
+    smooth: SmoothArgs,
 }
 
 #[derive(Serialize)]
@@ -32,7 +34,8 @@ struct MeasureOut {
 }
 
 pub fn run(args: &MeasureArgs) -> Result<(), Failure> {
-    let scan = scan::load(&args.mesh, &args.frame.options()).map_err(Failure::bad_input)?;
+    let mut scan = scan::load(&args.mesh, &args.frame.options()).map_err(Failure::bad_input)?;
+    scan.body.taubin_smooth(args.smooth.smooth);
     let file = scan.source.display().to_string();
     for w in scan.cleaning.warnings() {
         warn(&file, &w);

@@ -45,6 +45,15 @@ pub struct FrameArgs {
     facing: Option<Direction>,
 }
 
+/// Denoising before measuring.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SmoothArgs {
+    /// Taubin smoothing passes applied to the scan before measuring (0: none). Scanner noise
+    /// otherwise inflates tape girths by several millimetres.
+    #[arg(long, default_value_t = dressform::mesh::smooth::DEFAULT_PASSES)]
+    smooth: usize,
+}
+
 impl FrameArgs {
     fn options(&self) -> FrameOptions {
         FrameOptions { units: self.units, up: self.up, facing: self.facing }

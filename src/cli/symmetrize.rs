@@ -1,7 +1,7 @@
 //! `dressform symmetrize <scan> -o <dir> [--torso-layers N] [--leg-layers N] [--rays N]
 //! [--preserve tape|contour] [--scan-frame] [--json]`.
 
-use super::{Failure, FrameArgs, progress_bar, warn};
+use super::{Failure, FrameArgs, SmoothArgs, progress_bar, warn};
 use dressform::mannequin::MannequinOptions;
 use dressform::measure::Comparison;
 use dressform::mesh::topology;
@@ -39,12 +39,15 @@ pub struct SymmetrizeArgs {
     json: bool,
     #[command(flatten)]
     frame: FrameArgs,
+    #[command(flatten)]
+    smooth: SmoothArgs,
 }
 
 pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     let bar = progress_bar(args.json, STEPS.len() as u64 + 2);
     bar.set_message("reading the scan");
-    let scan = scan::load(&args.scan, &args.frame.options()).map_err(Failure::bad_input)?;
+    let mut scan = scan::load(&args.scan, &args.frame.options()).map_err(Failure::bad_input)?;
+    scan.body.taubin_smooth(args.smooth.smooth);
     let file = scan.source.display().to_string();
     for w in scan.cleaning.warnings().into_iter().chain(topology(&scan.body).warnings()) {
         bar.suspend(|| warn(&file, &w));

@@ -5,14 +5,16 @@
 //! - **chest**: the largest torso tape girth from 10% of the height below the armpits up to
 //!   1% below them (bust/chest: maximum girth just below the armpits);
 //! - **hip**: where the buttocks protrude most (the torso's greatest +Y, i.e. backward, extent)
-//!   between the crotch and 35% of the way up to the armpits;
+//!   between the crotch and 35% of the way up to the armpits; where they protrude within 1 mm of
+//!   that over a range of levels (a flat seat), the middle of that range;
 //! - **waist**: the narrowest torso level between 30% and 80% of the way from the hip level to
 //!   the chest level; where that band has no narrowest point inside it (a round belly), the
 //!   level 55% of the way. (ISO 8559-1 puts the waist midway between the lowest rib and the
 //!   iliac crest; a scan has neither landmark, so the narrowing is the evidence used.)
-//! - **height** (stature): floor to crown, from the heights of the vertices averaged with
-//!   their neighbours (so one noisy vertex of a scan does not set it); **crotch height**: the
-//!   crotch landmark.
+//! - **height** (stature): floor to crown; **crotch height**: the crotch landmark.
+//!
+//! Scanner noise inflates tape girths (the hull rides on the outermost noise) and heights:
+//! the commands that measure denoise the scan first ([`Mesh::taubin_smooth`]).
 //!
 //! The mannequin is measured at the same levels: it lives in the same frame, so a height on it
 //! is the same height on the input.
@@ -93,7 +95,17 @@ pub fn levels(body: &Mesh, regions: &BodyRegions) -> Levels {
         .map_or(armpit - 0.05 * m.height, |b| b.0);
     let hip_band = (m.crotch, m.crotch + 0.35 * (armpit - m.crotch));
     let back = |c: &Contour| c.points.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max);
-    let hip = best(hip_band, &back).map_or(m.crotch + 0.15 * (armpit - m.crotch), |b| b.0);
+    let hip = match best(hip_band, &back) {
+        Some((_, most)) => {
+            let seat: Vec<f64> = samples
+                .iter()
+                .filter(|(z, c)| *z >= hip_band.0 && *z <= hip_band.1 && back(c) >= most - 1.0)
+                .map(|(z, _)| *z)
+                .collect();
+            0.5 * (seat[0] + seat[seat.len() - 1])
+        }
+        None => m.crotch + 0.15 * (armpit - m.crotch),
+    };
     let band = (hip + 0.3 * (chest - hip), hip + 0.8 * (chest - hip));
     let narrowest = best(band, &|c| -c.tape_girth()).map(|b| b.0);
     let interior = narrowest.filter(|&z| z > band.0 + LEVEL_STEP_MM && z < band.1 - LEVEL_STEP_MM);
@@ -111,30 +123,12 @@ pub fn measure_at(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> Measur
             .map_or(Girth { z: zs[k], tape: 0.0, contour: 0.0 }, |c| Girth::of(zs[k], c))
     };
     Measurements {
-        height: stature(body),
+        height: regions.landmarks.height,
         crotch_height: regions.landmarks.crotch,
         chest: girth(0),
         waist: girth(1),
         hip: girth(2),
     }
-}
-
-/// Floor-to-crown height of `body`: the extremes of its vertex heights after averaging each
-/// with its neighbours' (one pass over the triangles).
-pub fn stature(body: &Mesh) -> f64 {
-    let mut sum = vec![0.0; body.positions.len()];
-    let mut count = vec![0u32; body.positions.len()];
-    for tri in &body.triangles {
-        let z: f64 = tri.iter().map(|&v| body.positions[v as usize].z).sum();
-        for &v in tri {
-            sum[v as usize] += z;
-            count[v as usize] += 3;
-        }
-    }
-    let smoothed = sum.iter().zip(&count).filter(|&(_, &n)| n > 0).map(|(s, &n)| s / f64::from(n));
-    let (lo, hi) =
-        smoothed.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| (lo.min(z), hi.max(z)));
-    hi - lo
 }
 
 /// The loop around the symmetry plane x = `axis` at each height, for a mesh with no arms or
