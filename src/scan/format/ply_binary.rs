@@ -81,14 +81,9 @@ impl Cursor<'_> {
     /// Reads one scalar of type `t` as f64 (exact for every integer type).
     fn number(&mut self, t: Num) -> Result<f64, ReadError> {
         Ok(match t {
-            Num::I8 => i8::from_le_bytes(self.take()?).into(),
-            Num::U8 => u8::from_le_bytes(self.take()?).into(),
-            Num::I16 => i16::from_le_bytes(self.take()?).into(),
-            Num::U16 => u16::from_le_bytes(self.take()?).into(),
-            Num::I32 => i32::from_le_bytes(self.take()?).into(),
-            Num::U32 => u32::from_le_bytes(self.take()?).into(),
             Num::F32 => f32::from_le_bytes(self.take()?).into(),
             Num::F64 => f64::from_le_bytes(self.take()?),
+            _ => self.integer(t)? as f64,
         })
     }
 
