@@ -2,6 +2,7 @@
 
 use super::{Aabb, Mesh};
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// One connected piece of a mesh.
 #[derive(Debug, Clone, PartialEq)]
@@ -23,44 +24,66 @@ pub struct Components {
     pub of_triangle: Vec<u32>,
 }
 
-/// The connected components of `mesh` (union-find over vertices, then one pass for the
-/// pieces' areas and boxes).
+/// The connected components of `mesh`: a union-find over vertices, then one parallel pass for
+/// the pieces' triangle counts, areas and boxes.
 pub fn components(mesh: &Mesh) -> Components {
     let mut sets = DisjointSets::new(mesh.positions.len());
     for &[a, b, c] in &mesh.triangles {
         sets.union(a as usize, b as usize);
         sets.union(a as usize, c as usize);
     }
+    // Number the pieces in order of first appearance, one id per vertex.
     let mut id_of_root = vec![u32::MAX; mesh.positions.len()];
-    let mut parts: Vec<Component> = Vec::new();
-    let empty = Aabb { min: DVec3::INFINITY, max: DVec3::NEG_INFINITY };
-    let mut of_triangle = Vec::with_capacity(mesh.triangles.len());
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        let root = sets.find(tri[0] as usize);
+    let mut count = 0u32;
+    let mut id_of_vertex = vec![u32::MAX; mesh.positions.len()];
+    for v in 0..mesh.positions.len() {
+        let root = sets.find(v);
         if id_of_root[root] == u32::MAX {
-            id_of_root[root] = parts.len() as u32;
-            parts.push(Component { triangles: 0, area: 0.0, bounds: empty });
+            id_of_root[root] = count;
+            count += 1;
         }
-        let id = id_of_root[root];
-        of_triangle.push(id);
-        let part = &mut parts[id as usize];
-        let corners = mesh.corners(t);
-        part.triangles += 1;
-        part.area += 0.5 * (corners[1] - corners[0]).cross(corners[2] - corners[0]).length();
-        for p in corners {
-            part.bounds.min = part.bounds.min.min(p);
-            part.bounds.max = part.bounds.max.max(p);
-        }
+        id_of_vertex[v] = id_of_root[root];
     }
+    let of_triangle: Vec<u32> =
+        mesh.triangles.par_iter().map(|tri| id_of_vertex[tri[0] as usize]).collect();
+    let empty = || {
+        vec![
+            Component {
+                triangles: 0,
+                area: 0.0,
+                bounds: Aabb { min: DVec3::INFINITY, max: DVec3::NEG_INFINITY }
+            };
+            count as usize
+        ]
+    };
+    let parts = (0..mesh.triangles.len())
+        .into_par_iter()
+        .fold(empty, |mut parts, t| {
+            let part = &mut parts[of_triangle[t] as usize];
+            let [a, b, c] = mesh.corners(t);
+            part.triangles += 1;
+            part.area += 0.5 * (b - a).cross(c - a).length();
+            part.bounds.min = part.bounds.min.min(a).min(b).min(c);
+            part.bounds.max = part.bounds.max.max(a).max(b).max(c);
+            parts
+        })
+        .reduce(empty, |mut x, y| {
+            for (p, q) in x.iter_mut().zip(y) {
+                p.triangles += q.triangles;
+                p.area += q.area;
+                p.bounds.min = p.bounds.min.min(q.bounds.min);
+                p.bounds.max = p.bounds.max.max(q.bounds.max);
+            }
+            x
+        });
+    // Largest area first.
     let mut order: Vec<usize> = (0..parts.len()).collect();
     order.sort_by(|&a, &b| parts[b].area.total_cmp(&parts[a].area));
     let mut rank = vec![0u32; parts.len()];
     for (r, &id) in order.iter().enumerate() {
         rank[id] = r as u32;
     }
-    for id in &mut of_triangle {
-        *id = rank[*id as usize];
-    }
+    let of_triangle = of_triangle.into_par_iter().map(|id| rank[id as usize]).collect();
     let parts = order.into_iter().map(|id| parts[id].clone()).collect();
     Components { parts, of_triangle }
 }

@@ -11,6 +11,7 @@
 //! [`crate::mesh::topology`] and [`Topology::warnings`].
 
 use crate::mesh::{Aabb, Mesh, components};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// What cleaning found and did.
@@ -93,6 +94,7 @@ pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
     let before = mesh.triangles.len();
     let scale = mesh.bounds().map_or(0.0, |b| b.size().length_squared());
     let keep: Vec<bool> = (0..mesh.triangles.len())
+        .into_par_iter()
         .map(|t| {
             let [a, b, c] = mesh.triangles[t];
             a != b && b != c && a != c && mesh.triangle_area(t) > scale * 1e-16

@@ -249,18 +249,28 @@ impl Moments {
     }
 }
 
-/// Sums `moments(centroid, area)` over all triangles, in parallel.
+/// Each triangle's centroid and area, computed once (in parallel).
+fn samples(mesh: &Mesh) -> Vec<(DVec3, f64)> {
+    mesh.triangles
+        .par_iter()
+        .map(|tri| {
+            let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+            ((a + b + c) / 3.0, 0.5 * (b - a).cross(c - a).length())
+        })
+        .collect()
+}
+
+/// Sums `add(moments, centroid, area)` over all `samples`, in parallel.
 fn accumulate<const N: usize>(
-    mesh: &Mesh,
+    samples: &[(DVec3, f64)],
     add: impl Fn(&mut [Moments; N], DVec3, f64) + Sync,
 ) -> [Moments; N] {
-    (0..mesh.triangles.len())
-        .into_par_iter()
+    samples
+        .par_iter()
         .fold(
             || [Moments::default(); N],
-            |mut acc, t| {
-                let [a, b, c] = mesh.corners(t);
-                add(&mut acc, (a + b + c) / 3.0, 0.5 * (b - a).cross(c - a).length());
+            |mut acc, &(p, a)| {
+                add(&mut acc, p, a);
                 acc
             },
         )
@@ -270,11 +280,13 @@ fn accumulate<const N: usize>(
 /// Finds the canonical frame of `mesh` (a cleaned body), honouring `options`.
 pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, FrameError> {
     let bounds = mesh.bounds().unwrap_or(crate::mesh::Aabb { min: DVec3::ZERO, max: DVec3::ZERO });
+    let samples = samples(mesh);
     let up = match options.up {
         Some(up) => up,
         None => {
             let axis = bounds.size().max_position();
-            let [all] = accumulate(mesh, |m: &mut [Moments; 1], p, a| m[0].add(p, a, DVec2::ZERO));
+            let [all] =
+                accumulate(&samples, |m: &mut [Moments; 1], p, a| m[0].add(p, a, DVec2::ZERO));
             let centroid = all.mean().unwrap_or(bounds.min);
             Direction {
                 axis,
@@ -299,7 +311,7 @@ pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, Fra
     let e1 = Direction { axis: (up.axis + 1) % 3, negative: false }.vector();
     let e2 = Direction { axis: (up.axis + 2) % 3, negative: false }.vector();
     let flat = |p: DVec3| DVec2::new(p.dot(e1), p.dot(e2));
-    let [trunk, feet, shins] = accumulate(mesh, |m: &mut [Moments; 3], p, a| {
+    let [trunk, feet, shins] = accumulate(&samples, |m: &mut [Moments; 3], p, a| {
         let f = (p.dot(u) - floor) / height;
         let band = match f {
             _ if (0.45..=0.75).contains(&f) => 0,
