@@ -35,15 +35,16 @@ pub fn components(mesh: &Mesh) -> Components {
     // Number the pieces in order of first appearance, one id per vertex.
     let mut id_of_root = vec![u32::MAX; mesh.positions.len()];
     let mut count = 0u32;
-    let mut id_of_vertex = vec![u32::MAX; mesh.positions.len()];
-    for v in 0..mesh.positions.len() {
-        let root = sets.find(v);
-        if id_of_root[root] == u32::MAX {
-            id_of_root[root] = count;
-            count += 1;
-        }
-        id_of_vertex[v] = id_of_root[root];
-    }
+    let id_of_vertex: Vec<u32> = (0..mesh.positions.len())
+        .map(|v| {
+            let root = sets.find(v);
+            if id_of_root[root] == u32::MAX {
+                id_of_root[root] = count;
+                count += 1;
+            }
+            id_of_root[root]
+        })
+        .collect();
     let of_triangle: Vec<u32> =
         mesh.triangles.par_iter().map(|tri| id_of_vertex[tri[0] as usize]).collect();
     let empty = || {

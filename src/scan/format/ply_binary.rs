@@ -178,7 +178,7 @@ fn decode(cursor: &mut Cursor, header: &Header, layouts: &[Layout]) -> Result<Me
                         "the vertex element lacks an x, y or z property".into(),
                     ));
                 };
-                let need = element.count.checked_mul(*stride).unwrap_or(usize::MAX);
+                let need = element.count.saturating_mul(*stride);
                 if cursor.bytes.len() - cursor.at < need {
                     return Err(ReadError::Truncated(format!(
                         "{} vertices need {need} bytes, {} remain",
@@ -199,7 +199,7 @@ fn decode(cursor: &mut Cursor, header: &Header, layouts: &[Layout]) -> Result<Me
                 }
             }
             (_, Layout::Scalars(stride, _)) => {
-                cursor.skip(element.count.checked_mul(*stride).unwrap_or(usize::MAX))?;
+                cursor.skip(element.count.saturating_mul(*stride))?;
             }
             (_, Layout::Face(types, list)) => {
                 let vertices = positions.len();

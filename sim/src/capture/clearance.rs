@@ -1,0 +1,154 @@
+//! Clearance rules: the arms must stay apart from the torso where the girths are measured
+//! (so the chest, waist and hip sections hold the torso alone) and the hands apart from the
+//! thighs. Checked on the designed anatomy, before calibration.
+
+use glam::DVec3;
+
+use super::anatomy::{Anatomy, SIDE_NAME};
+use super::params::{BodyParams, ParamError, arm_field};
+use super::torso::Loft;
+
+/// Least gap (mm) between an arm and the torso at the girth levels, and between a hand and a
+/// thigh: more than the widest blend below the shoulder (the upper arm's, 18 mm), so the arms
+/// leave the torso's sections untouched, and far more than the 9 mm below which a blend would
+/// bridge the gap.
+pub(crate) const LIMB_CLEARANCE_MM: f64 = 20.0;
+
+/// Horizontal clearance between a limb segment and the torso at height `z`, if the segment
+/// crosses it: distance from the segment's axis to the torso boundary (enlarged 2% for the
+/// calibration and by the bust on the front) minus the segment's horizontal half-thickness.
+fn torso_clearance(a: &Anatomy, z: f64, from: DVec3, to: DVec3, radius: f64) -> Option<f64> {
+    if (from.z - z) * (to.z - z) > 0.0 || (from.z - to.z).abs() < 1e-9 {
+        return None;
+    }
+    let t = (from.z - z) / (from.z - to.z);
+    let axis = from.lerp(to, t);
+    let cos_tilt = (from.z - to.z).abs() / from.distance(to);
+    let r_eff = radius / cos_tilt.max(0.25);
+    let section = Loft::new(&a.knots).at(z);
+    let (dx, dy) = (axis.x, axis.y - section.centre_y());
+    let r = dx.hypot(dy);
+    if r < 1e-9 {
+        return Some(-r_eff);
+    }
+    let mut reach = 1.02 * section.boundary_radius(dx / r, dy / r);
+    if dy < 0.0 {
+        reach += a.bust_protrusion * (-dy / r);
+    }
+    Some(r - reach - r_eff)
+}
+
+/// Distance between the point `p` and the segment `a`-`b`.
+fn point_segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let t = ((p - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
+    p.distance(a + ab * t)
+}
+
+/// A limb closer to the torso or a thigh than [`LIMB_CLEARANCE_MM`].
+struct Violation {
+    side: usize,
+    part: &'static str,
+    obstacle: &'static str,
+    z: f64,
+    gap: f64,
+}
+
+/// The first clearance violation of the arms on `sides`: an arm segment crossing a girth level
+/// too close to the torso, or a hand too close to a thigh.
+fn first_violation(a: &Anatomy, sides: &[usize]) -> Option<Violation> {
+    for &side in sides {
+        let arm = &a.arms[side];
+        let segments = [
+            ("upper arm", arm.shoulder, arm.elbow, arm.r_upper),
+            ("forearm", arm.elbow, arm.wrist, arm.r_forearm),
+            ("hand", arm.wrist, arm.fingertip, 0.24 * arm.hand_length),
+        ];
+        for z in a.levels {
+            for (part, from, to, radius) in segments {
+                match torso_clearance(a, z, from, to, radius) {
+                    Some(gap) if gap < LIMB_CLEARANCE_MM => {
+                        return Some(Violation { side, part, obstacle: "torso", z, gap });
+                    }
+                    _ => {}
+                }
+            }
+        }
+        let hand_points = [
+            (arm.wrist, arm.r_wrist),
+            (arm.wrist.lerp(arm.fingertip, 0.5), 0.24 * arm.hand_length),
+            (arm.fingertip, 0.1 * arm.hand_length),
+        ];
+        for leg in &a.legs {
+            for (point, radius) in hand_points {
+                let gap = point_segment_distance(point, leg.hip, leg.knee) - leg.r_hip - radius;
+                if gap < LIMB_CLEARANCE_MM {
+                    return Some(Violation {
+                        side,
+                        part: "hand",
+                        obstacle: "thigh",
+                        z: point.z,
+                        gap,
+                    });
+                }
+            }
+        }
+    }
+    None
+}
+
+/// The abduction of the arm on `side`.
+fn abduction_mut(p: &mut BodyParams, side: usize) -> &mut f64 {
+    if side == 0 { &mut p.pose.left_arm.abduction_deg } else { &mut p.pose.right_arm.abduction_deg }
+}
+
+/// The least abduction (whole degrees, at most 100) that clears the arm on `side`.
+fn least_clear_abduction(p: &BodyParams, side: usize) -> Option<f64> {
+    let mut q = p.clone();
+    let mut deg = abduction_mut(&mut q, side).ceil();
+    while deg <= 100.0 {
+        *abduction_mut(&mut q, side) = deg;
+        if first_violation(&Anatomy::new(&q), &[side]).is_none() {
+            return Some(deg);
+        }
+        deg += 1.0;
+    }
+    None
+}
+
+/// Checks that each arm clears the torso by [`LIMB_CLEARANCE_MM`] at the chest, waist and hip
+/// levels and each hand clears both thighs; the error names the arm's abduction and suggests
+/// a value that clears.
+pub(crate) fn check_clearances(a: &Anatomy, p: &BodyParams) -> Result<(), ParamError> {
+    let Some(v) = first_violation(a, &[0, 1]) else {
+        return Ok(());
+    };
+    let mut q = p.clone();
+    let hint = match least_clear_abduction(p, v.side) {
+        Some(deg) => format!("raise it to about {deg:.0} degrees"),
+        None => "no abduction up to 100 degrees clears it: reduce the arm's flexion or the \
+                 torso's girths"
+            .to_string(),
+    };
+    Err(ParamError::LimbTooClose {
+        field: arm_field(SIDE_NAME[v.side], "abduction_deg"),
+        value: *abduction_mut(&mut q, v.side),
+        side: SIDE_NAME[v.side],
+        part: v.part,
+        obstacle: v.obstacle,
+        z_mm: v.z,
+        clearance_mm: v.gap,
+        required_mm: LIMB_CLEARANCE_MM,
+        hint,
+    })
+}
+
+/// Raises each arm's abduction to the least value that passes the clearance checks (if one
+/// up to 100 degrees does); used by [`BodyParams::random`].
+pub(crate) fn open_arms_until_clear(p: &mut BodyParams) {
+    for side in 0..2 {
+        if let Some(deg) = least_clear_abduction(p, side) {
+            *abduction_mut(p, side) = deg.max(*abduction_mut(p, side));
+        }
+    }
+}

@@ -1,0 +1,173 @@
+//! Parameter validation: every invalid value is refused with an error naming its field, never
+//! a panic; bodies at the corners of the allowed ranges generate.
+
+#[path = "support/section.rs"]
+mod section;
+#[path = "support/topology.rs"]
+mod topology;
+
+use rayon::prelude::*;
+use sim::capture::{BodyParams, ParamError, generate};
+
+/// A field: its name, its setter, and a value just below and just above its range.
+type Field = (&'static str, fn(&mut BodyParams, f64), f64, f64);
+
+/// Every numeric field.
+fn fields() -> Vec<Field> {
+    vec![
+        ("height_mm", |p, v| p.height_mm = v, 1390.0, 2110.0),
+        ("chest_girth_mm", |p, v| p.chest_girth_mm = v, 640.0, 1450.0),
+        ("waist_girth_mm", |p, v| p.waist_girth_mm = v, 490.0, 1110.0),
+        ("hip_girth_mm", |p, v| p.hip_girth_mm = v, 760.0, 1350.0),
+        ("shoulder_width_mm", |p, v| p.shoulder_width_mm = v, 300.0, 480.0),
+        ("leg_length_mm", |p, v| p.leg_length_mm = v, 710.0, 860.0),
+        ("bust_prominence", |p, v| p.bust_prominence = v, -0.01, 1.01),
+        ("resolution_mm", |p, v| p.resolution_mm = v, 1.9, 12.1),
+        ("pose.left_arm.abduction_deg", |p, v| p.pose.left_arm.abduction_deg = v, 9.0, 101.0),
+        ("pose.right_arm.abduction_deg", |p, v| p.pose.right_arm.abduction_deg = v, 9.0, 101.0),
+        ("pose.left_arm.flexion_deg", |p, v| p.pose.left_arm.flexion_deg = v, -31.0, 61.0),
+        ("pose.right_arm.flexion_deg", |p, v| p.pose.right_arm.flexion_deg = v, -31.0, 61.0),
+        (
+            "pose.left_arm.elbow_flexion_deg",
+            |p, v| p.pose.left_arm.elbow_flexion_deg = v,
+            -1.0,
+            61.0,
+        ),
+        (
+            "pose.right_arm.elbow_flexion_deg",
+            |p, v| p.pose.right_arm.elbow_flexion_deg = v,
+            -1.0,
+            61.0,
+        ),
+        (
+            "pose.left_arm.shoulder_elevation_mm",
+            |p, v| p.pose.left_arm.shoulder_elevation_mm = v,
+            -16.0,
+            41.0,
+        ),
+        (
+            "pose.right_arm.shoulder_elevation_mm",
+            |p, v| p.pose.right_arm.shoulder_elevation_mm = v,
+            -16.0,
+            41.0,
+        ),
+        ("pose.left_leg.abduction_deg", |p, v| p.pose.left_leg.abduction_deg = v, 1.9, 20.1),
+        ("pose.right_leg.abduction_deg", |p, v| p.pose.right_leg.abduction_deg = v, 1.9, 20.1),
+        ("pose.left_leg.toe_out_deg", |p, v| p.pose.left_leg.toe_out_deg = v, -10.1, 30.1),
+        ("pose.right_leg.toe_out_deg", |p, v| p.pose.right_leg.toe_out_deg = v, -10.1, 30.1),
+    ]
+}
+
+/// The field an error names.
+fn named_field(e: &ParamError) -> Option<&'static str> {
+    match e {
+        ParamError::NotFinite { field, .. }
+        | ParamError::OutOfRange { field, .. }
+        | ParamError::LimbTooClose { field, .. } => Some(field),
+        _ => None,
+    }
+}
+
+#[test]
+fn every_invalid_value_names_its_field() {
+    for (name, set, below, above) in fields() {
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, below, above] {
+            let mut p = BodyParams::default();
+            set(&mut p, bad);
+            let err = p.validate().expect_err(&format!("{name} = {bad} accepted"));
+            assert_eq!(named_field(&err), Some(name), "{name} = {bad}: {err}");
+            let message = err.to_string();
+            assert!(message.contains(name), "{message}");
+            // generate refuses the same parameters, without panicking.
+            let refused = generate(&p).expect_err("generate accepted invalid parameters");
+            assert_eq!(refused.to_string(), message);
+        }
+    }
+}
+
+#[test]
+fn range_messages_state_the_range() {
+    let p = BodyParams { leg_length_mm: 600.0, ..BodyParams::default() };
+    let message = p.validate().expect_err("short legs").to_string();
+    assert_eq!(
+        message,
+        "leg_length_mm = 600 is outside its allowed range 714 ..= 850 mm \
+         (0.42 ..= 0.5 times height_mm)"
+    );
+    let p = BodyParams { height_mm: 2500.0, ..BodyParams::default() };
+    assert_eq!(
+        p.validate().expect_err("giant").to_string(),
+        "height_mm = 2500 is outside its allowed range 1400 ..= 2100 mm"
+    );
+}
+
+#[test]
+fn arms_too_close_to_the_torso_are_refused_with_a_suggestion() {
+    let mut p = BodyParams::default();
+    p.pose.right_arm.abduction_deg = 15.0;
+    let err = p.validate().expect_err("arm against the torso");
+    assert_eq!(named_field(&err), Some("pose.right_arm.abduction_deg"));
+    let ParamError::LimbTooClose { hint, .. } = &err else {
+        panic!("{err}");
+    };
+    // Following the suggestion gives valid parameters.
+    let suggested: f64 =
+        hint.split_whitespace().find_map(|w| w.parse().ok()).expect("a suggested angle");
+    p.pose.right_arm.abduction_deg = suggested;
+    assert_eq!(p.validate(), Ok(()));
+}
+
+/// Bodies at extremes of the allowed ranges (coarse grid for speed) generate closed and
+/// manifold with their girths.
+#[test]
+fn corner_bodies_generate() {
+    let base = BodyParams { resolution_mm: 8.0, ..BodyParams::default() };
+    let corners = [
+        // Short, heavy, round belly, wide hips.
+        (1400.0, 1150.0, 1300.0, 1600.0, 0.18, 0.42, 1.0),
+        // Tall and slim.
+        (2100.0, 800.0, 560.0, 800.0, 0.28, 0.50, 0.0),
+        // Tall and heavy.
+        (2100.0, 1600.0, 1600.0, 1700.0, 0.26, 0.44, 0.3),
+        // Short and slim, long legs.
+        (1400.0, 650.0, 500.0, 750.0, 0.22, 0.50, 0.6),
+    ];
+    corners.par_iter().for_each(|&(h, c, w, hip, s, l, bust)| {
+        let mut p = BodyParams {
+            height_mm: h,
+            chest_girth_mm: c,
+            waist_girth_mm: w,
+            hip_girth_mm: hip,
+            shoulder_width_mm: s * h,
+            leg_length_mm: l * h,
+            bust_prominence: bust,
+            ..base.clone()
+        };
+        // Open the arms as far as the clearance rules ask.
+        for _ in 0..2 {
+            if let Err(ParamError::LimbTooClose { hint, field, .. }) = p.validate() {
+                let deg: f64 =
+                    hint.split_whitespace().find_map(|w| w.parse().ok()).unwrap_or(100.0);
+                if field.contains("left") {
+                    p.pose.left_arm.abduction_deg = deg;
+                } else {
+                    p.pose.right_arm.abduction_deg = deg;
+                }
+            }
+        }
+        let body = generate(&p).unwrap_or_else(|e| panic!("{p:?}: {e}"));
+        let t = topology::topology(&body.surface);
+        assert_eq!(
+            (t.bad_edges, t.boundary_edges, t.non_manifold_vertices, t.components),
+            (0, 0, 0, 1),
+            "{p:?}: {t:?}"
+        );
+        for (level, requested) in
+            [(&body.truth.chest, c), (&body.truth.waist, w), (&body.truth.hip, hip)]
+        {
+            let (girth, _) = section::tape_girth(&body.surface, level.z_mm, level.centre_xy_mm)
+                .expect("torso loop");
+            assert!((girth / requested - 1.0).abs() < 0.005, "{p:?}: {girth} vs {requested}");
+        }
+    });
+}
