@@ -3,6 +3,7 @@
 mod demo;
 mod info;
 mod measure;
+mod sim;
 mod slice;
 mod symmetrize;
 
@@ -27,6 +28,8 @@ enum Command {
     Measure(measure::MeasureArgs),
     /// Build the symmetric mannequin of a scan: mannequin.obj, profiles.json, measurements.json.
     Symmetrize(symmetrize::SymmetrizeArgs),
+    /// Start a simulated robotic form on a pseudo-terminal and print its device path.
+    Sim(sim::SimArgs),
     /// Run the pipeline on a built-in synthetic customer, no files or hardware needed.
     Demo(demo::DemoArgs),
 }
@@ -86,6 +89,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         Command::Slice(a) => slice::run(&a),
         Command::Measure(a) => measure::run(&a),
         Command::Symmetrize(a) => symmetrize::run(&a),
+        Command::Sim(a) => sim::run(&a),
         Command::Demo(a) => demo::run(&a),
     }
 }

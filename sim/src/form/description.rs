@@ -1,0 +1,205 @@
+//! The description's types, its TOML loaders, look-ups and geometry.
+
+use std::path::Path;
+
+use firmware_protocol::{Actuator, NodeId, Position};
+use serde::{Deserialize, Serialize};
+
+use super::FormError;
+
+/// A robotic dress form: its nodes, the rings its actuators sit on, and the actuators.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FormDescription {
+    /// A name for people and logs.
+    pub name: String,
+    /// The controller boards on the bus (`[[node]]`).
+    #[serde(rename = "node", default)]
+    pub nodes: Vec<NodeSpec>,
+    /// Horizontal rows of actuators (`[[ring]]`).
+    #[serde(rename = "ring", default)]
+    pub rings: Vec<RingSpec>,
+    /// The actuators (`[[actuator]]`).
+    #[serde(rename = "actuator", default)]
+    pub actuators: Vec<ActuatorSpec>,
+}
+
+/// One node (controller board).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NodeSpec {
+    /// Its bus address, 1..=63.
+    pub address: u8,
+    /// What it drives, for people.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub label: Option<String>,
+}
+
+/// A horizontal ring of actuators at one height.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RingSpec {
+    /// Its name (`neck`, `chest`, `thigh-l`, ...).
+    pub name: String,
+    /// Height above the floor, mm.
+    pub height_mm: f64,
+    /// The ring's axis in the X-Y plane, mm: `[0, 0]` (the body axis) unless off-centre,
+    /// like a thigh.
+    #[serde(default, skip_serializing_if = "is_origin")]
+    pub center_mm: [f64; 2],
+    /// For an off-centre ring: the ring that mirrors it across x = 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mirror: Option<String>,
+}
+
+fn is_origin(center: &[f64; 2]) -> bool {
+    *center == [0.0, 0.0]
+}
+
+/// One linear actuator pushing one panel of the form.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ActuatorSpec {
+    /// Stable id (`chest-l2`): set-point files and fault specs name actuators by it.
+    pub id: String,
+    /// Address of the node driving it.
+    pub node: u8,
+    /// Its index on that node, 0..=7.
+    pub channel: u8,
+    /// The ring it sits on.
+    pub ring: String,
+    /// Angle around the ring's axis, degrees in [0, 360): 0 = front (-Y), 90 = the subject's
+    /// left (+X), counter-clockwise seen from above.
+    pub angle_deg: f64,
+    /// Distance of the panel from the ring's axis when fully retracted, mm.
+    pub base_radius_mm: f64,
+    /// Width of the panel (its chord, tangential to the ring), mm.
+    pub panel_width_mm: f64,
+    /// Travel from fully retracted (0) outwards, mm.
+    pub stroke_mm: f64,
+    /// Speed limit, mm/s.
+    pub max_speed_mm_s: f64,
+    /// Acceleration (and deceleration) limit, mm/s².
+    pub max_accel_mm_s2: f64,
+    /// Id of its mirror partner (a left actuator names its right partner).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mirror: Option<String>,
+}
+
+impl ActuatorSpec {
+    /// The stroke as a protocol position (0.01 mm).
+    pub fn stroke(&self) -> Position {
+        Position::from_mm(self.stroke_mm as f32).unwrap_or(Position::ZERO)
+    }
+
+    /// The speed limit in the protocol's unit, 0.01 mm/s.
+    pub fn max_speed(&self) -> u16 {
+        // `as` saturates (and maps NaN to 0); validation keeps the value in range.
+        (self.max_speed_mm_s * 100.0).round() as u16
+    }
+
+    /// The acceleration limit in the protocol's unit, 0.1 mm/s².
+    pub fn max_accel(&self) -> u16 {
+        (self.max_accel_mm_s2 * 10.0).round() as u16
+    }
+
+    /// Its node's id, if the address is valid.
+    pub fn node_id(&self) -> Option<NodeId> {
+        NodeId::new(self.node)
+    }
+
+    /// Its index on the node, if valid.
+    pub fn actuator(&self) -> Option<Actuator> {
+        Actuator::new(self.channel)
+    }
+
+    /// The unit vector, in the X-Y plane, along which its panel moves out.
+    pub fn direction(&self) -> [f64; 2] {
+        let angle = self.angle_deg.to_radians();
+        [angle.sin(), -angle.cos()]
+    }
+}
+
+impl FormDescription {
+    /// Parses and validates a TOML description.
+    pub fn from_toml_str(text: &str) -> Result<Self, FormError> {
+        let form: Self =
+            toml::from_str(text).map_err(|source| FormError::Toml { path: None, source })?;
+        form.validate().map_err(|problems| FormError::Invalid { path: None, problems })?;
+        Ok(form)
+    }
+
+    /// Reads, parses and validates a TOML description file; errors name the file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, FormError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| FormError::Io { path: path.to_owned(), source })?;
+        Self::from_toml_str(&text).map_err(|error| match error {
+            FormError::Toml { source, .. } => FormError::Toml { path: Some(path.into()), source },
+            FormError::Invalid { problems, .. } => {
+                FormError::Invalid { path: Some(path.into()), problems }
+            }
+            io => io,
+        })
+    }
+
+    /// The description as TOML (what [`from_toml_str`](Self::from_toml_str) reads back).
+    pub fn to_toml_string(&self) -> String {
+        // Plain structs of strings, numbers and arrays always serialise.
+        toml::to_string(self).unwrap_or_default()
+    }
+
+    /// The nodes' ids, in file order (valid addresses only).
+    pub fn node_ids(&self) -> impl Iterator<Item = NodeId> + '_ {
+        self.nodes.iter().filter_map(|n| NodeId::new(n.address))
+    }
+
+    /// The actuators of a node, by channel.
+    pub fn actuators_of(&self, node: NodeId) -> Vec<&ActuatorSpec> {
+        let mut actuators: Vec<_> =
+            self.actuators.iter().filter(|a| a.node == node.get()).collect();
+        actuators.sort_by_key(|a| a.channel);
+        actuators
+    }
+
+    /// The actuator with this id.
+    pub fn actuator(&self, id: &str) -> Option<&ActuatorSpec> {
+        self.actuators.iter().find(|a| a.id == id)
+    }
+
+    /// The ring with this name.
+    pub fn ring(&self, name: &str) -> Option<&RingSpec> {
+        self.rings.iter().find(|r| r.name == name)
+    }
+
+    /// Where an actuator is on the bus: its node and index.
+    pub fn locate(&self, id: &str) -> Option<(NodeId, Actuator)> {
+        let actuator = self.actuator(id)?;
+        Some((actuator.node_id()?, actuator.actuator()?))
+    }
+
+    /// The actuator at this node and index.
+    pub fn actuator_at(&self, node: NodeId, actuator: Actuator) -> Option<&ActuatorSpec> {
+        self.actuators.iter().find(|a| a.node == node.get() && a.actuator() == Some(actuator))
+    }
+
+    /// An actuator's mirror partner: the one it names, the one naming it, or itself for a
+    /// centre-line actuator.
+    pub fn mirror_of(&self, id: &str) -> Option<&ActuatorSpec> {
+        let actuator = self.actuator(id)?;
+        if let Some(partner) = actuator.mirror.as_deref() {
+            return self.actuator(partner);
+        }
+        Some(self.actuators.iter().find(|a| a.mirror.as_deref() == Some(id)).unwrap_or(actuator))
+    }
+
+    /// Where an actuator's panel centre is, in the canonical frame (mm), at `extension_mm`
+    /// from retracted.
+    pub fn panel_position(&self, id: &str, extension_mm: f64) -> Option<[f64; 3]> {
+        let actuator = self.actuator(id)?;
+        let ring = self.ring(&actuator.ring)?;
+        let [dx, dy] = actuator.direction();
+        let radius = actuator.base_radius_mm + extension_mm;
+        Some([ring.center_mm[0] + radius * dx, ring.center_mm[1] + radius * dy, ring.height_mm])
+    }
+}
