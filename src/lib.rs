@@ -7,12 +7,14 @@
 //! - [`slice`]: horizontal cross-sections and their girths;
 //! - [`regions`]: body regions and landmarks (crotch, armpits, neck) from tracked slices;
 //! - [`symmetry`]: axial (torso) and bilateral (legs) symmetry of sections, girth preserved;
+//! - [`fitting`]: the robotic form's rings placed on the mannequin, set-points, fidelity;
 //! - [`mannequin`]: the symmetric mannequin: layers, symmetry, watertight rebuild;
 //! - [`measure`]: height, crotch height, chest/waist/hip girths; Table 1 and Fig. 11;
 //! - [`pipeline`]: scan to mannequin in one call; [`profiles`]: the `profiles.json` format;
 //! - [`report`]: what `dressform info` says about a scan;
 //! - [`output`]: atomic file writes.
 
+pub mod fitting;
 pub mod mannequin;
 pub mod measure;
 pub mod mesh;

@@ -6,6 +6,7 @@
 //!   "frame": "canonical: mm, Z up, floor at z = 0, +X = subject's left, facing -Y",
 //!   "axis_x": 0.0,                    // the symmetry plane x = axis_x
 //!   "rays": 360, "preserve": "tape",
+//!   "levels": { "chest": .., "waist": .., "hip": .. },   // measurement levels (mm)
 //!   "landmarks": { "height": .., "crotch": .., "ankle": .., "left_armpit": .., "right_armpit": ..,
 //!                  "neck": .., "centre_x": .., "arm_cut": .. },
 //!   "layers": [                       // legs (left, right), then torso; each bottom to top
@@ -20,6 +21,7 @@
 //! ```
 
 use crate::mannequin::{Layer, Mannequin};
+use crate::measure::Levels;
 use crate::regions::{Landmarks, Region};
 use crate::symmetry::Preserve;
 use serde::{Deserialize, Serialize};
@@ -40,6 +42,8 @@ pub struct Profiles {
     pub rays: usize,
     /// The girth each layer kept.
     pub preserve: Preserve,
+    /// The chest, waist and hip levels (mm).
+    pub levels: Levels,
     /// The input body's landmarks.
     pub landmarks: Landmarks,
     /// Every layer: legs (left, right), then torso, each bottom to top.
@@ -83,14 +87,15 @@ impl From<&Layer> for ProfileLayer {
 }
 
 impl Profiles {
-    /// The profiles of `m`.
-    pub fn of(m: &Mannequin) -> Self {
+    /// The profiles of `m`, whose body was measured at `levels`.
+    pub fn of(m: &Mannequin, levels: &Levels) -> Self {
         Profiles {
             format: FORMAT.into(),
             frame: "canonical: mm, Z up, floor at z = 0, +X = subject's left, facing -Y".into(),
             axis_x: m.axis,
             rays: m.options.rays,
             preserve: m.options.preserve,
+            levels: *levels,
             landmarks: m.landmarks,
             layers: m
                 .left_leg

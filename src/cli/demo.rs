@@ -58,7 +58,8 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         ("mannequin.obj", Format::Obj.encode(&result.mannequin.mesh)),
         (
             "profiles.json",
-            serde_json::to_vec_pretty(&Profiles::of(&result.mannequin)).map_err(Failure::other)?,
+            serde_json::to_vec_pretty(&Profiles::of(&result.mannequin, &result.comparison.levels))
+                .map_err(Failure::other)?,
         ),
         (
             "measurements.json",

@@ -75,7 +75,10 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     let measurements = pretty_json(&result.comparison)?;
     let outputs = [
         ("mannequin.obj", Format::Obj.encode(&mesh)),
-        ("profiles.json", pretty_json(&Profiles::of(&result.mannequin))?.into_bytes()),
+        (
+            "profiles.json",
+            pretty_json(&Profiles::of(&result.mannequin, &result.comparison.levels))?.into_bytes(),
+        ),
         ("measurements.json", measurements.clone().into_bytes()),
     ];
     for (name, bytes) in &outputs {

@@ -49,7 +49,7 @@ impl Girth {
 }
 
 /// The measurement levels of a body.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct Levels {
     /// Chest level (mm).
     pub chest: f64,

@@ -18,11 +18,17 @@ pub fn direction(i: usize, n: usize) -> DVec2 {
 
 /// Distance from `centre` to the farthest crossing of `contour` along each of `n` rays.
 pub fn cast(contour: &Contour, centre: DVec2, n: usize) -> Vec<f64> {
+    let directions: Vec<DVec2> = (0..n).map(|i| direction(i, n)).collect();
+    cast_along(contour, centre, &directions)
+}
+
+/// Distance from `centre` to the farthest crossing of `contour` along each unit direction.
+pub fn cast_along(contour: &Contour, centre: DVec2, directions: &[DVec2]) -> Vec<f64> {
     let pts = &contour.points;
     let m = pts.len();
-    (0..n)
-        .map(|i| {
-            let d = direction(i, n);
+    directions
+        .iter()
+        .map(|&d| {
             let mut farthest: Option<f64> = None;
             for k in 0..m {
                 let (a, b) = (pts[k] - centre, pts[(k + 1) % m] - centre);

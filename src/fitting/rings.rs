@@ -1,0 +1,180 @@
+//! Solving one ring: the extensions that make the form's section match the mannequin's.
+//!
+//! The form's section at extensions `e` is modelled as the skin stretched over its panels: the
+//! convex hull of the panels (flat plates of their width, tangential, centred at
+//! `centre + (base_radius + e) · direction`). Each actuator's shape target is where its
+//! direction meets the mannequin's section (`R`, the farthest crossing); all targets then move
+//! by one radial offset `δ`, found by bisection, so that the skin's girth equals the
+//! mannequin's tape girth — girth first, shape second. Extensions are clamped to the stroke;
+//! an actuator whose target lies beyond it is reported with the excess.
+
+use super::Placement;
+use super::placement::Anchor;
+use crate::profiles::{ProfileLayer, Profiles};
+use crate::regions::Region;
+use crate::slice::{Contour, convex_hull};
+use crate::symmetry::rays::cast_along;
+use glam::DVec2;
+use serde::Serialize;
+use sim::form::{ActuatorSpec, FormDescription, RingSpec};
+
+/// An actuator that cannot reach its target.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Saturation {
+    /// The actuator.
+    pub actuator: String,
+    /// How far its target lies beyond its travel (mm): positive past the full stroke (the
+    /// mannequin is larger there), negative below the retracted end (smaller).
+    pub beyond_mm: f64,
+}
+
+/// How one ring fits.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RingFit {
+    /// The ring.
+    pub ring: String,
+    /// The mannequin level it is anchored to, if any.
+    pub anchor: Option<Anchor>,
+    /// Where the ring is built on the form (mm).
+    pub form_height_mm: f64,
+    /// The mannequin height it shapes (mm).
+    pub mannequin_height_mm: f64,
+    /// `form_height_mm - mannequin_height_mm`: how far the ring sits from its level.
+    pub offset_mm: f64,
+    /// The mannequin's tape girth there (mm); 0 where the mannequin has no section.
+    pub mannequin_girth_mm: f64,
+    /// The form's girth at the set-points (mm).
+    pub form_girth_mm: f64,
+    /// The largest distance, along an actuator's direction, between its panel and the
+    /// mannequin (mm).
+    pub largest_radial_gap_mm: f64,
+    /// Actuators that cannot reach their targets.
+    pub saturated: Vec<Saturation>,
+}
+
+/// The mannequin's section (relative to the form's axis) at height `z` in `region`: the blend
+/// of the two layers around it (layers of one region have the same number of points).
+fn section_at(profiles: &Profiles, region: Region, z: f64) -> Option<Contour> {
+    let layers: Vec<&ProfileLayer> =
+        profiles.layers.iter().filter(|l| l.region == region).collect();
+    let k = layers.windows(2).position(|w| w[0].z <= z && z <= w[1].z)?;
+    let (a, b) = (layers[k], layers[k + 1]);
+    let t = if b.z > a.z { (z - a.z) / (b.z - a.z) } else { 0.0 };
+    let shift = DVec2::new(profiles.axis_x, 0.0);
+    let points = a
+        .points
+        .iter()
+        .zip(&b.points)
+        .map(|(p, q)| DVec2::from_array(*p).lerp(DVec2::from_array(*q), t) - shift)
+        .collect();
+    Some(Contour { points })
+}
+
+/// The mannequin region a ring shapes: the torso, or the leg on the side of an off-centre ring.
+fn region_of(ring: &RingSpec) -> Region {
+    match ring.center_mm[0] {
+        x if x > 1.0 => Region::LeftLeg,
+        x if x < -1.0 => Region::RightLeg,
+        _ => Region::Torso,
+    }
+}
+
+/// Girth of the skin over the panels of `actuators` at `extensions`.
+fn skin_girth(centre: DVec2, actuators: &[&ActuatorSpec], extensions: &[f64]) -> f64 {
+    let ends: Vec<DVec2> = actuators
+        .iter()
+        .zip(extensions)
+        .flat_map(|(a, e)| {
+            let d = DVec2::from_array(a.direction());
+            let middle = centre + d * (a.base_radius_mm + e);
+            let half = d.perp() * (0.5 * a.panel_width_mm);
+            [middle - half, middle + half]
+        })
+        .collect();
+    Contour { points: convex_hull(&ends) }.perimeter()
+}
+
+/// Fits one ring; returns its report and the extensions of its actuators.
+pub(super) fn fit_ring(
+    profiles: &Profiles,
+    form: &FormDescription,
+    ring: &RingSpec,
+    placement: &Placement,
+) -> Result<(RingFit, Vec<(String, f64)>), super::FitError> {
+    let actuators: Vec<&ActuatorSpec> =
+        form.actuators.iter().filter(|a| a.ring == ring.name).collect();
+    if actuators.is_empty() {
+        return Err(super::FitError::EmptyRing(ring.name.clone()));
+    }
+    let z = placement.mannequin_height(ring.height_mm);
+    let centre = DVec2::from_array(ring.center_mm);
+    let mut report = RingFit {
+        ring: ring.name.clone(),
+        anchor: Anchor::of_ring(&ring.name),
+        form_height_mm: ring.height_mm,
+        mannequin_height_mm: z,
+        offset_mm: ring.height_mm - z,
+        mannequin_girth_mm: 0.0,
+        form_girth_mm: 0.0,
+        largest_radial_gap_mm: 0.0,
+        saturated: Vec::new(),
+    };
+    let Some(section) = section_at(profiles, region_of(ring), z) else {
+        // No mannequin there (above the neck, below the legs): the ring stays retracted.
+        let zeros = vec![0.0; actuators.len()];
+        report.form_girth_mm = skin_girth(centre, &actuators, &zeros);
+        return Ok((report, actuators.iter().map(|a| (a.id.clone(), 0.0)).collect()));
+    };
+    let directions: Vec<DVec2> =
+        actuators.iter().map(|a| DVec2::from_array(a.direction())).collect();
+    let reach = cast_along(&section, centre, &directions);
+    let target = section.tape_girth();
+    let raw = |delta: f64| -> Vec<f64> {
+        actuators.iter().zip(&reach).map(|(a, r)| r - a.base_radius_mm + delta).collect()
+    };
+    let clamped = |delta: f64| -> Vec<f64> {
+        raw(delta).iter().zip(&actuators).map(|(e, a)| e.clamp(0.0, a.stroke_mm)).collect()
+    };
+    let girth = |delta: f64| skin_girth(centre, &actuators, &clamped(delta));
+    // Bracket: below `lo` every panel is retracted, above `hi` every panel is at full stroke.
+    let spread = |f: fn(f64, f64) -> f64, init: f64| {
+        actuators.iter().zip(&reach).map(|(a, r)| r - a.base_radius_mm).fold(init, f)
+    };
+    let longest_stroke = actuators.iter().map(|a| a.stroke_mm).fold(0.0, f64::max);
+    let (mut lo, mut hi) = (
+        -spread(f64::max, f64::NEG_INFINITY) - 1.0,
+        longest_stroke - spread(f64::min, f64::INFINITY) + 1.0,
+    );
+    let delta = if girth(hi) <= target {
+        hi
+    } else if girth(lo) >= target {
+        lo
+    } else {
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if girth(mid) < target { lo = mid } else { hi = mid }
+        }
+        0.5 * (lo + hi)
+    };
+    let extensions = clamped(delta);
+    report.mannequin_girth_mm = target;
+    report.form_girth_mm = skin_girth(centre, &actuators, &extensions);
+    report.largest_radial_gap_mm = actuators
+        .iter()
+        .zip(&reach)
+        .zip(&extensions)
+        .map(|((a, r), e)| (a.base_radius_mm + e - r).abs())
+        .fold(0.0, f64::max);
+    // Where the girth is matched, the excess is measured at the solution; where the girth is out
+    // of reach, at the shape targets themselves (no common offset).
+    let matched = (report.form_girth_mm - target).abs() < 0.01;
+    report.saturated = actuators
+        .iter()
+        .zip(raw(if matched { delta } else { 0.0 }))
+        .filter_map(|(a, e)| {
+            let beyond = if e > a.stroke_mm { e - a.stroke_mm } else { e.min(0.0) };
+            (beyond.abs() > 0.05).then(|| Saturation { actuator: a.id.clone(), beyond_mm: beyond })
+        })
+        .collect();
+    Ok((report, actuators.iter().map(|a| a.id.clone()).zip(extensions).collect()))
+}
