@@ -12,8 +12,11 @@
 //! - [`measure`]: height, crotch height, chest/waist/hip girths; Table 1 and Fig. 11;
 //! - [`pipeline`]: scan to mannequin in one call; [`profiles`]: the `profiles.json` format;
 //! - [`report`]: what `dressform info` says about a scan;
-//! - [`output`]: atomic file writes.
+//! - [`output`]: atomic file writes;
+//! - [`setpoints`]: the set-point file (actuator id → extension, mm) the controller drives to;
+//! - [`controller`]: the host controller: drives the robotic form over serial, slcan, SocketCAN or the simulated bus.
 
+pub mod controller;
 pub mod fitting;
 pub mod mannequin;
 pub mod measure;
@@ -24,5 +27,6 @@ pub mod profiles;
 pub mod regions;
 pub mod report;
 pub mod scan;
+pub mod setpoints;
 pub mod slice;
 pub mod symmetry;

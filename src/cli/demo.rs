@@ -1,14 +1,15 @@
-//! `dressform demo [--out DIR] [--seed N]`: the pipeline on a built-in synthetic customer —
+//! `dressform demo [--out DIR] [--seed N]`: the whole system on a built-in synthetic customer —
 //! generate a body with known measurements (`sim`), scan it with a typical scanner's artifacts
-//! (noise, holes, metres, Y up, turned), write and read back the scan, then build the symmetric
-//! mannequin, and compare the customer's true girths with the scan's and the mannequin's.
+//! (noise, holes, metres, Y up, turned), write and read back the scan, build the symmetric
+//! mannequin, fit the reference form and drive the simulated form over the in-process bus —
+//! then compare the customer's true girths with the scan's and the mannequin's.
 
+use super::drive::SimArgs;
+use super::run::shape_form;
 use super::{Failure, progress_bar};
-use dressform::mannequin::MannequinOptions;
-use dressform::mesh::{Mesh, topology};
+use dressform::controller::LinkSpec;
+use dressform::mesh::{Mesh, smooth::DEFAULT_PASSES};
 use dressform::output::write_atomically;
-use dressform::pipeline::{STEPS, symmetrize};
-use dressform::profiles::Profiles;
 use dressform::report::ScanInfo;
 use dressform::scan::{self, format::Format, frame::FrameOptions};
 use glam::DVec3;
@@ -17,7 +18,7 @@ use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
 pub struct DemoArgs {
-    /// Where to write the scan and the mannequin.
+    /// Where to write the scan, the mannequin and the set-points.
     #[arg(long, default_value = "dressform-demo")]
     out: PathBuf,
     /// A different customer: random body measurements from this seed (default: a 1700 mm adult
@@ -27,7 +28,7 @@ pub struct DemoArgs {
 }
 
 pub fn run(args: &DemoArgs) -> Result<(), Failure> {
-    let bar = progress_bar(false, STEPS.len() as u64 + 4);
+    let bar = progress_bar(false, 3);
     let params = args.seed.map_or_else(BodyParams::default, BodyParams::random);
     bar.set_message("generating the customer");
     let customer = generate(&params).map_err(Failure::other)?;
@@ -46,29 +47,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
     bar.set_message("reading the scan back");
     let mut scan = scan::load(&scan_path, &FrameOptions::default()).map_err(Failure::bad_input)?;
     let info = ScanInfo::new(&scan);
-    scan.body.taubin_smooth(dressform::mesh::smooth::DEFAULT_PASSES);
-    bar.inc(1);
-    let result = symmetrize(&scan, &MannequinOptions::default(), |step| {
-        bar.inc(1);
-        bar.set_message(STEPS[step]);
-    })
-    .map_err(|e| Failure::other(format!("{}: {e}", scan_path.display())))?;
-    bar.set_message("writing");
-    let outputs = [
-        ("mannequin.obj", Format::Obj.encode(&result.mannequin.mesh)),
-        (
-            "profiles.json",
-            serde_json::to_vec_pretty(&Profiles::of(&result.mannequin, &result.comparison.levels))
-                .map_err(Failure::other)?,
-        ),
-        (
-            "measurements.json",
-            serde_json::to_vec_pretty(&result.comparison).map_err(Failure::other)?,
-        ),
-    ];
-    for (name, bytes) in &outputs {
-        write_atomically(&args.out.join(name), bytes).map_err(Failure::other)?;
-    }
+    scan.body.taubin_smooth(DEFAULT_PASSES);
     bar.finish_and_clear();
 
     let truth = &customer.truth;
@@ -85,31 +64,22 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         artifacts.noise_sigma_mm, artifacts.yaw_deg
     );
     print!("{info}");
-    let mannequin = &result.mannequin;
-    let t = topology(&mannequin.mesh);
-    println!(
-        "Symmetric mannequin: {} torso and {} + {} leg layers, {} triangles, {}closed, {}manifold.",
-        mannequin.torso.len(),
-        mannequin.left_leg.len(),
-        mannequin.right_leg.len(),
-        mannequin.mesh.triangles.len(),
-        if t.is_closed() { "" } else { "not " },
-        if t.is_manifold() { "" } else { "not " }
-    );
     println!();
-    println!("  {:<14} {:>10} {:>10} {:>10}", "girth (mm)", "customer", "scan", "mannequin");
+    let result =
+        shape_form(&scan, &sim::form::reference(), &LinkSpec::Sim, &SimArgs::default(), &args.out)?;
+    println!();
+    println!("  {:<12} {:>9} {:>9} {:>11}", "measure (mm)", "customer", "scan", "mannequin");
     let c = &result.comparison;
-    let heights = (truth.height_mm, c.input.height);
-    println!("  {:<14} {:>10.1} {:>10.1} {:>10}", "height", heights.0, heights.1, "-");
+    println!("  {:<12} {:>9.1} {:>9.1} {:>11}", "height", truth.height_mm, c.input.height, "-");
     for (row, asked) in c.table.iter().zip([truth.chest, truth.waist, truth.hip]) {
         println!(
-            "  {:<14} {:>10.1} {:>10.1} {:>10.1}",
+            "  {:<12} {:>9.1} {:>9.1} {:>11.1}",
             row.measure, asked.tape_girth_mm, row.input.tape, row.mannequin.tape
         );
     }
     println!();
     println!(
-        "Written to {}: scan.ply, mannequin.obj, profiles.json, measurements.json",
+        "Written to {}: scan.ply, mannequin.obj, profiles.json, measurements.json, setpoints.json",
         args.out.display()
     );
     Ok(())

@@ -1,10 +1,15 @@
 //! Command-line arguments and dispatch. Each command lives in its own module.
 
 mod demo;
+mod drive;
+mod estop;
 mod info;
 mod measure;
+mod run;
+mod setpoints;
 mod sim;
 mod slice;
+mod status;
 mod symmetrize;
 
 use clap::{Parser, Subcommand};
@@ -28,10 +33,20 @@ enum Command {
     Measure(measure::MeasureArgs),
     /// Build the symmetric mannequin of a scan: mannequin.obj, profiles.json, measurements.json.
     Symmetrize(symmetrize::SymmetrizeArgs),
+    /// Compute the actuator set-points that give the robotic form a mannequin's shape.
+    Setpoints(setpoints::SetpointsArgs),
+    /// Scan to shaped form in one command: mannequin, set-points, drive, girth report.
+    Run(run::RunArgs),
     /// Start a simulated robotic form on a pseudo-terminal and print its device path.
     Sim(sim::SimArgs),
     /// Run the pipeline on a built-in synthetic customer, no files or hardware needed.
     Demo(demo::DemoArgs),
+    /// Drive the robotic form to a set-point file, all actuators together, with live progress.
+    Drive(drive::DriveArgs),
+    /// Show every node of the robotic form: identity, state, faults, positions.
+    Status(status::StatusArgs),
+    /// Broadcast an emergency stop to every node of the robotic form.
+    Estop(estop::EstopArgs),
 }
 
 /// How the scan's frame is given on the command line (all optional: detected by default).
@@ -89,8 +104,13 @@ pub fn run(args: Args) -> Result<(), Failure> {
         Command::Slice(a) => slice::run(&a),
         Command::Measure(a) => measure::run(&a),
         Command::Symmetrize(a) => symmetrize::run(&a),
+        Command::Setpoints(a) => setpoints::run(&a),
+        Command::Run(a) => run::run(&a),
         Command::Sim(a) => sim::run(&a),
         Command::Demo(a) => demo::run(&a),
+        Command::Drive(a) => drive::run(&a),
+        Command::Status(a) => status::run(&a),
+        Command::Estop(a) => estop::run(&a),
     }
 }
 

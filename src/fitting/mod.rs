@@ -16,7 +16,7 @@ mod placement;
 mod rings;
 
 pub use placement::{Anchor, Placement};
-pub use rings::{RingFit, Saturation};
+pub use rings::{RingFit, Saturation, region_of, ring_girth};
 
 use crate::profiles::Profiles;
 use serde::Serialize;

@@ -17,6 +17,7 @@ use crate::symmetry::rays::cast_along;
 use glam::DVec2;
 use serde::Serialize;
 use sim::form::{ActuatorSpec, FormDescription, RingSpec};
+use std::collections::BTreeMap;
 
 /// An actuator that cannot reach its target.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -71,12 +72,26 @@ fn section_at(profiles: &Profiles, region: Region, z: f64) -> Option<Contour> {
 }
 
 /// The mannequin region a ring shapes: the torso, or the leg on the side of an off-centre ring.
-fn region_of(ring: &RingSpec) -> Region {
+pub fn region_of(ring: &RingSpec) -> Region {
     match ring.center_mm[0] {
         x if x > 1.0 => Region::LeftLeg,
         x if x < -1.0 => Region::RightLeg,
         _ => Region::Torso,
     }
+}
+
+/// The girth of the form's skin on `ring` with its actuators at `positions_mm` (id → mm;
+/// missing ids count as retracted).
+pub fn ring_girth(
+    form: &FormDescription,
+    ring: &RingSpec,
+    positions_mm: &BTreeMap<String, f64>,
+) -> f64 {
+    let actuators: Vec<&ActuatorSpec> =
+        form.actuators.iter().filter(|a| a.ring == ring.name).collect();
+    let extensions: Vec<f64> =
+        actuators.iter().map(|a| positions_mm.get(&a.id).copied().unwrap_or(0.0)).collect();
+    skin_girth(DVec2::from_array(ring.center_mm), &actuators, &extensions)
 }
 
 /// Girth of the skin over the panels of `actuators` at `extensions`.

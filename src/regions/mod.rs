@@ -148,6 +148,23 @@ impl BodyRegions {
             .collect()
     }
 
+    /// The section of `region` at each of `heights`: the torso's as [`Self::torso_sections`],
+    /// another region's as its largest loop.
+    pub fn sections_of(
+        &self,
+        body: &Mesh,
+        region: Region,
+        heights: &[f64],
+    ) -> Vec<Option<Contour>> {
+        if region == Region::Torso {
+            return self.torso_sections(body, heights);
+        }
+        sections(body, heights)
+            .into_iter()
+            .map(|s| largest_with(&s, &self.label(&s), region).cloned())
+            .collect()
+    }
+
     /// Labels for the loops of `section` (cut from the same body at any height): each loop
     /// takes the label of the tracked loop that holds its centroid (or, failing that, the
     /// nearest tracked centroid) at the nearest tracked level between the same landmarks, so

@@ -1,0 +1,288 @@
+//! The host controller: drives the robotic form over serial, CAN, slcan or the in-process
+//! simulated bus.
+//!
+//! [`drive`] runs one shape change: check the set-points against the form description
+//! (nothing outside a stroke, see [`safety`]), discover every node and check it against the
+//! description ([`session`]), enable and home, one synchronised move with live progress and
+//! per-actuator report ([`motion`]), then disable (the drives hold the panels).
+//!
+//! | module | what it holds |
+//! |---|---|
+//! | [`transport`] | the [`Transport`] trait; serial, slcan, SocketCAN and simulated links |
+//! | [`session`] | discovery, enable/home, heartbeats and polls, liveness, reboots |
+//! | [`motion`] | staging, the common SYNC duration, watching feedback, the report |
+//! | [`safety`] | [`SafeTarget`]: the only way a target reaches the wire |
+//! | [`simulated`] | the whole thing on the in-process simulated form |
+//!
+//! Safety rules, all enforced here: targets come only from [`SafeTarget`]s built against the
+//! description's strokes (checked against what every node reports); the SYNC duration is
+//! never shorter than the shortest feasible for every actuator; a fault broadcasts `Halt`;
+//! a lost node, a reboot that cannot be resumed or a failed link end the move with an error;
+//! a stop request (Ctrl-C) broadcasts `EmergencyStop`.
+
+pub mod motion;
+pub mod safety;
+pub mod session;
+pub mod simulated;
+pub mod transport;
+
+use std::time::Duration;
+
+use firmware_protocol::drive::{DriveState, Faults};
+use firmware_protocol::{Message, NodeId, Packet};
+use serde::Serialize;
+use sim::form::FormDescription;
+use tokio::sync::watch;
+use tokio::time::Instant;
+
+pub use motion::{ActuatorReport, MoveError, NodeProgress, PlannedTarget, Progress};
+pub use safety::SafeTarget;
+pub use session::{NodeProblem, Session, SessionError};
+pub use transport::{Connection, LinkSpec, Transport, TransportError};
+
+use crate::setpoints::{OutOfStroke, SetPoints};
+
+/// Set-points clamped into the stroke: `(actuator id, asked mm, used mm)`.
+pub type Clamped = Vec<(String, f64, f64)>;
+
+/// The default tolerance, mm.
+pub const DEFAULT_TOLERANCE_MM: f64 = 0.1;
+
+/// How a drive runs.
+#[derive(Clone, Debug)]
+pub struct DriveOptions {
+    /// Clamp out-of-stroke set-points instead of refusing them.
+    pub clamp: bool,
+    /// An actuator within this of its target has arrived, mm (default 0.1).
+    pub tolerance_mm: f64,
+    /// Multiply the shortest duration by this (default 1: the shortest; values below 1
+    /// count as 1).
+    pub slower: f64,
+    /// The move lasts at least this long (default 0: the shortest).
+    pub min_duration: Duration,
+    /// How long past the planned duration to wait for every actuator (default 2 s).
+    pub settle: Duration,
+    /// How long homing may take (default 30 s).
+    pub homing_timeout: Duration,
+    /// Turn this to `true` to stop: an emergency stop is broadcast (Ctrl-C).
+    pub stop: Option<watch::Receiver<bool>>,
+}
+
+impl Default for DriveOptions {
+    fn default() -> Self {
+        Self {
+            clamp: false,
+            tolerance_mm: DEFAULT_TOLERANCE_MM,
+            slower: 1.0,
+            min_duration: Duration::ZERO,
+            settle: Duration::from_secs(2),
+            homing_timeout: Duration::from_secs(30),
+            stop: None,
+        }
+    }
+}
+
+/// What a drive did.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DriveReport {
+    /// The form's name.
+    pub form: String,
+    /// The link (`/dev/ttyUSB0`, `can0`, `simulated bus`).
+    pub device: String,
+    /// The SYNC's duration, ms.
+    pub duration_ms: u64,
+    /// From the SYNC to the end of watching, ms.
+    pub elapsed_ms: u64,
+    /// Every actuator of the set-points, in id order.
+    pub actuators: Vec<ActuatorReport>,
+    /// Set-points clamped into the stroke: `(id, asked mm, used mm)`.
+    pub clamped: Clamped,
+    /// Warnings from the nodes (`DurationTooShort`, ...) and resumed reboots.
+    pub warnings: Vec<String>,
+}
+
+impl DriveReport {
+    /// Every actuator arrived within tolerance.
+    pub fn converged(&self) -> bool {
+        self.actuators.iter().all(|a| a.within_tolerance)
+    }
+}
+
+/// Why a drive failed.
+#[derive(Debug, thiserror::Error)]
+pub enum DriveError {
+    /// The set-points ask for positions outside the stroke (nothing was sent).
+    #[error(transparent)]
+    OutOfStroke(#[from] OutOfStroke),
+    /// The session failed.
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    /// The move failed.
+    #[error(transparent)]
+    Move(#[from] MoveError),
+    /// Some actuators did not arrive within tolerance in time.
+    #[error("{} actuators not within tolerance after {} ms: {}", .0.actuators.iter().filter(|a| !a.within_tolerance).count(), .0.elapsed_ms, .0.actuators.iter().filter(|a| !a.within_tolerance).map(|a| a.id.as_str()).collect::<Vec<_>>().join(", "))]
+    NotReached(Box<DriveReport>),
+}
+
+/// The plan of a move: every set-point's actuator with its checked target and limits.
+pub fn plan(
+    form: &FormDescription,
+    setpoints: &SetPoints,
+    clamp: bool,
+) -> Result<(Vec<PlannedTarget>, Clamped), OutOfStroke> {
+    let checked = setpoints.check(form, clamp)?;
+    let plan = checked
+        .targets
+        .iter()
+        .filter_map(|(id, &target)| {
+            let spec = form.actuator(id)?;
+            Some(PlannedTarget {
+                id: id.clone(),
+                node: spec.node_id()?,
+                actuator: spec.actuator()?,
+                target,
+                max_speed: spec.max_speed(),
+                max_accel: spec.max_accel(),
+                stroke: spec.stroke().hundredths_mm(),
+            })
+        })
+        .collect();
+    Ok((plan, checked.clamped))
+}
+
+/// Drives the form to `setpoints`: checks them (refusing or clamping out-of-stroke
+/// positions before anything is sent), discovers and checks every node, enables and homes,
+/// moves every actuator together, watches until all are within tolerance, then disables.
+/// `progress` is called about every 50 ms during the move.
+pub async fn drive<T: Transport>(
+    transport: T,
+    form: &FormDescription,
+    setpoints: &SetPoints,
+    options: &DriveOptions,
+    mut progress: impl FnMut(&Progress),
+) -> Result<DriveReport, DriveError> {
+    let (plan, clamped) = plan(form, setpoints, options.clamp)?;
+    let device = transport.device();
+    let mut session = Session::new(transport, form, options.stop.clone());
+    session.discover().await?;
+    session.enable_all(options.homing_timeout).await?;
+    let move_options = motion::MoveOptions {
+        tolerance_mm: options.tolerance_mm,
+        slower: options.slower,
+        min_duration: options.min_duration,
+        settle: options.settle,
+    };
+    let started = Instant::now();
+    let result =
+        motion::run(&mut session, &plan, &move_options, options.homing_timeout, &mut progress)
+            .await;
+    let (duration_ms, actuators, warnings) = match result {
+        Ok(done) => done,
+        Err(MoveError::Session(e)) => return Err(e.into()),
+        Err(e) => return Err(e.into()),
+    };
+    let elapsed_ms = started.elapsed().as_millis() as u64;
+    session.disable_all().await?;
+    let report = DriveReport {
+        form: form.name.clone(),
+        device,
+        duration_ms,
+        elapsed_ms,
+        actuators,
+        clamped,
+        warnings,
+    };
+    if report.converged() { Ok(report) } else { Err(DriveError::NotReached(Box::new(report))) }
+}
+
+/// One node as `dressform status` shows it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NodeReport {
+    /// Its address.
+    pub node: u8,
+    /// `Identity` answered.
+    pub identified: bool,
+    /// Its protocol version, `major.minor`.
+    pub protocol: Option<String>,
+    /// Its firmware version.
+    pub firmware: Option<String>,
+    /// Its drive state.
+    pub state: Option<String>,
+    /// Its latched faults.
+    pub faults: Vec<String>,
+    /// Actuator id → position, mm (`None`: not homed or not reported).
+    pub positions_mm: Vec<(String, Option<f64>)>,
+    /// Problems against the description.
+    pub problems: Vec<String>,
+}
+
+/// The state of every node of `form`, without changing it: identifies each (problems are
+/// reported, not fatal), then listens (and polls, on serial) for `listen`.
+pub async fn status<T: Transport>(
+    transport: T,
+    form: &FormDescription,
+    listen: Duration,
+) -> Result<Vec<NodeReport>, SessionError> {
+    let mut session = Session::new(transport, form, None);
+    let mut problems: Vec<(NodeId, Vec<NodeProblem>)> = Vec::new();
+    let nodes: Vec<NodeId> = form.node_ids().collect();
+    for &node in &nodes {
+        problems.push((node, session.identify(node).await?));
+    }
+    session.wait_until(Instant::now() + listen, |_| false).await?;
+    let reports = nodes
+        .iter()
+        .zip(problems)
+        .map(|(&node, (_, problems))| {
+            let status = session.nodes().get(&node).cloned().unwrap_or_default();
+            let heartbeat = status.heartbeat;
+            NodeReport {
+                node: node.get(),
+                identified: status.identity.is_some(),
+                protocol: status
+                    .identity
+                    .map(|i| format!("{}.{}", i.protocol.major, i.protocol.minor)),
+                firmware: status.identity.map(|i| {
+                    format!("{}.{}.{}", i.firmware.major, i.firmware.minor, i.firmware.patch)
+                }),
+                state: heartbeat.map(|h| state_name(h.state).to_string()),
+                faults: heartbeat.map(|h| fault_names(h.faults)).unwrap_or_default(),
+                positions_mm: form
+                    .actuators_of(node)
+                    .iter()
+                    .map(|a| {
+                        let p = a.actuator().and_then(|i| status.positions[i.index()]);
+                        (a.id.clone(), p.map(|p| f64::from(p.hundredths_mm()) / 100.0))
+                    })
+                    .collect(),
+                problems: problems.iter().map(ToString::to_string).collect(),
+            }
+        })
+        .collect();
+    Ok(reports)
+}
+
+/// The name of a drive state.
+pub fn state_name(state: DriveState) -> &'static str {
+    match state {
+        DriveState::Disabled => "Disabled",
+        DriveState::Enabled => "Enabled",
+        DriveState::Homing => "Homing",
+        DriveState::Fault => "Fault",
+    }
+}
+
+/// The names of latched fault flags.
+pub fn fault_names(faults: Faults) -> Vec<String> {
+    faults.iter_names().map(|(name, _)| name.to_string()).collect()
+}
+
+/// Broadcasts an emergency stop (three times, against a lossy bus): every node stops, powers
+/// off and latches `EMERGENCY_STOP` until a FaultReset.
+pub async fn emergency_stop<T: Transport>(mut transport: T) -> Result<(), TransportError> {
+    for _ in 0..3 {
+        transport.send(Packet::broadcast(Message::EmergencyStop)).await?;
+    }
+    Ok(())
+}

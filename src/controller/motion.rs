@@ -1,0 +1,443 @@
+//! A synchronised move of the whole form: stage every actuator's target, one SYNC with a
+//! common duration, then watch the feedback until every actuator is within tolerance.
+//!
+//! Packet handling: the targets go out as `update::packets` builds them for the link (two
+//! `Targets` halves per node on classic CAN, one `AllTargets` on CAN FD and serial), then the
+//! broadcast `Sync`. The duration is the largest `update::shortest_duration_ms` over every
+//! actuator's distance (from its last reported position; the full stroke when unknown) and
+//! the description's limits, so every actuator stays within its speed and acceleration
+//! limits and all arrive together; `--slower` and `--duration` only lengthen it.
+//!
+//! Safety: targets are [`SafeTarget`]s, and [`node_targets`] is the one place that turns them
+//! into wire positions. A fault event or a node in Fault broadcasts `Halt` (the faulty node is
+//! already stopping) and ends the move with the actuator and the reason. A node that reboots
+//! is re-identified, enabled, homed and given its targets again with a new SYNC (at most
+//! twice per move), or the move fails clearly.
+
+use std::collections::BTreeMap;
+use std::time::Duration;
+
+use firmware_protocol::actuator::MAX_ACTUATORS;
+use firmware_protocol::drive::{DriveCommand, DriveState, EmergencyCode};
+use firmware_protocol::message::Sync;
+use firmware_protocol::update::{NodeTargets, packets, shortest_duration_ms};
+use firmware_protocol::{Actuator, Message, NodeId, Packet};
+use serde::Serialize;
+use tokio::time::Instant;
+
+use super::safety::SafeTarget;
+use super::session::{Session, SessionError};
+use super::transport::Transport;
+
+/// How many times a move resumes after node reboots before it fails.
+pub const MAX_RESUMES: usize = 2;
+
+/// One actuator's part in a move.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedTarget {
+    /// Actuator id.
+    pub id: String,
+    /// Its node.
+    pub node: NodeId,
+    /// Its index on the node.
+    pub actuator: Actuator,
+    /// Where it goes.
+    pub target: SafeTarget,
+    /// Speed limit, 0.01 mm/s.
+    pub max_speed: u16,
+    /// Acceleration limit, 0.1 mm/s².
+    pub max_accel: u16,
+    /// Stroke, 0.01 mm (the distance assumed when the position is unknown).
+    pub stroke: u16,
+}
+
+/// How an actuator ended its move.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ActuatorReport {
+    /// Actuator id.
+    pub id: String,
+    /// Its node's address.
+    pub node: u8,
+    /// Target, mm.
+    pub target_mm: f64,
+    /// Last reported position, mm (`None`: unknown).
+    pub reached_mm: Option<f64>,
+    /// `reached - target`, mm.
+    pub error_mm: Option<f64>,
+    /// Within tolerance at the end.
+    pub within_tolerance: bool,
+    /// When it first came within tolerance, from the SYNC, ms.
+    pub settled_ms: Option<u64>,
+}
+
+/// Progress of a move, for a live display.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Progress {
+    /// Per node: `(address, label, actuators within tolerance, actuators moved, largest
+    /// remaining distance in mm)`.
+    pub nodes: Vec<NodeProgress>,
+    /// Time since the SYNC.
+    pub elapsed: Duration,
+    /// The move's planned duration.
+    pub duration: Duration,
+}
+
+/// One node's progress.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NodeProgress {
+    /// Its address.
+    pub node: u8,
+    /// Its label in the description (or `node N`).
+    pub label: String,
+    /// Actuators within tolerance.
+    pub within: usize,
+    /// Actuators in the move.
+    pub total: usize,
+    /// The largest remaining distance, mm (`None`: a position is unknown).
+    pub worst_mm: Option<f64>,
+}
+
+/// Why a move failed.
+#[derive(Debug, thiserror::Error)]
+pub enum MoveError {
+    /// The session failed (link, lost node, interrupted...).
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    /// A fault stopped the form.
+    #[error("fault on node {node}{}: {code_name} (0x{code:04X}, detail {detail}); every node halted", actuator.as_ref().map(|a| format!(", actuator {a}")).unwrap_or_default())]
+    Fault {
+        /// The node.
+        node: u8,
+        /// The actuator's id, if the fault names one.
+        actuator: Option<String>,
+        /// The emergency code.
+        code: u16,
+        /// Its name.
+        code_name: String,
+        /// Its detail.
+        detail: i32,
+    },
+    /// A node rebooted more often than the move resumes.
+    #[error("node {node} rebooted {times} times during the move; every node halted")]
+    Rebooted {
+        /// The node.
+        node: u8,
+        /// How many reboots.
+        times: usize,
+    },
+    /// No duration fits the protocol's 65.535 s.
+    #[error("the move needs {0} ms, more than a SYNC can carry (65535 ms)")]
+    TooLong(u64),
+}
+
+/// The name of an emergency code.
+pub fn code_name(code: EmergencyCode) -> String {
+    EmergencyCode::KNOWN
+        .iter()
+        .find(|(c, _)| *c == code)
+        .map_or_else(|| format!("unknown code 0x{:04X}", code.0), |(_, name)| (*name).to_string())
+}
+
+/// The wire targets of every node in `plan`: the one place targets become positions.
+pub fn node_targets(plan: &[PlannedTarget]) -> Vec<NodeTargets> {
+    let mut nodes: BTreeMap<NodeId, [Option<firmware_protocol::Position>; MAX_ACTUATORS]> =
+        BTreeMap::new();
+    for t in plan {
+        nodes.entry(t.node).or_default()[t.actuator.index()] = Some(t.target.position());
+    }
+    nodes.into_iter().map(|(node, targets)| NodeTargets { node, targets }).collect()
+}
+
+/// The shortest common duration for `plan` from the last reported positions, ms.
+pub fn shortest_common_duration<T: Transport>(session: &Session<T>, plan: &[PlannedTarget]) -> u64 {
+    plan.iter()
+        .map(|t| {
+            let current =
+                session.nodes().get(&t.node).and_then(|s| s.positions[t.actuator.index()]);
+            let distance = match current {
+                Some(p) => p.hundredths_mm().abs_diff(t.target.position().hundredths_mm()),
+                None => t.stroke,
+            };
+            // Limits of 0 cannot come from a valid description; take the longest then.
+            u64::from(shortest_duration_ms(distance, t.max_speed, t.max_accel).unwrap_or(u32::MAX))
+        })
+        .max()
+        .unwrap_or(0)
+}
+
+/// How a move is run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MoveOptions {
+    /// Tolerance, mm.
+    pub tolerance_mm: f64,
+    /// Multiply the shortest duration by this (≥ 1).
+    pub slower: f64,
+    /// At least this long.
+    pub min_duration: Duration,
+    /// How long past the planned duration to wait for every actuator to settle.
+    pub settle: Duration,
+}
+
+/// Stages `plan`, SYNCs and watches until every actuator is within tolerance or the
+/// settle time has passed after the planned duration. Returns the duration used and the
+/// reports (not within tolerance: see [`ActuatorReport::within_tolerance`]).
+pub async fn run<T: Transport>(
+    session: &mut Session<T>,
+    plan: &[PlannedTarget],
+    options: &MoveOptions,
+    homing_timeout: Duration,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<(u64, Vec<ActuatorReport>, Vec<String>), MoveError> {
+    let mut warnings = Vec::new();
+    let mut reboots: BTreeMap<NodeId, usize> = BTreeMap::new();
+    let (duration, started) = sync(session, plan, options).await?;
+    let mut planned = Duration::from_millis(duration);
+    let mut settled: BTreeMap<String, u64> = BTreeMap::new();
+    loop {
+        let deadline = started + planned + options.settle;
+        let tick = (Instant::now() + Duration::from_millis(50)).min(deadline);
+        let tol = options.tolerance_mm;
+        let done = session.wait_until(tick, |s| all_within(s, plan, tol)).await?;
+        for t in plan {
+            if within(session, t, tol) && !settled.contains_key(&t.id) {
+                settled.insert(t.id.clone(), started.elapsed().as_millis() as u64);
+            }
+        }
+        progress(&progress_of(session, plan, tol, started.elapsed(), planned));
+        // Faults first: they stop everything.
+        if let Some(error) = fault(session, plan, &mut warnings) {
+            session.send(Packet::broadcast(Message::Control(DriveCommand::Halt))).await?;
+            return Err(error);
+        }
+        let rebooted: Vec<NodeId> =
+            session.nodes().iter().filter(|(_, s)| s.rebooted).map(|(&n, _)| n).collect();
+        if !rebooted.is_empty() {
+            for &node in &rebooted {
+                let times = reboots.entry(node).or_default();
+                *times += 1;
+                if *times > MAX_RESUMES {
+                    session.send(Packet::broadcast(Message::Control(DriveCommand::Halt))).await?;
+                    return Err(MoveError::Rebooted { node: node.get(), times: *times });
+                }
+                warnings.push(format!("node {} rebooted during the move; resumed", node.get()));
+                if let Some(status) = session.node_mut(node) {
+                    status.rebooted = false;
+                    status.positions = [None; MAX_ACTUATORS];
+                }
+                let problems = session.identify(node).await?;
+                if !problems.is_empty() {
+                    return Err(SessionError::Discovery(problems).into());
+                }
+                session.enable(node).await?;
+            }
+            session.wait_ready(&rebooted, homing_timeout).await?;
+            let again: Vec<PlannedTarget> =
+                plan.iter().filter(|t| rebooted.contains(&t.node)).cloned().collect();
+            let (resumed, _) = sync(session, &again, options).await?;
+            // The whole move is watched until the resumed part is done too.
+            planned = planned.max(started.elapsed() + Duration::from_millis(resumed));
+            continue;
+        }
+        if done || Instant::now() >= deadline {
+            break;
+        }
+    }
+    let reports = plan
+        .iter()
+        .map(|t| {
+            let reached = position_mm(session, t);
+            let error = reached.map(|r| r - t.target.mm());
+            ActuatorReport {
+                id: t.id.clone(),
+                node: t.node.get(),
+                target_mm: t.target.mm(),
+                reached_mm: reached,
+                error_mm: error,
+                within_tolerance: error.is_some_and(|e| e.abs() <= options.tolerance_mm + 1e-9),
+                settled_ms: settled.get(&t.id).copied(),
+            }
+        })
+        .collect();
+    Ok((duration, reports, warnings))
+}
+
+/// Stages and SYNCs `plan`; returns the duration (ms) and when the (last) SYNC went out.
+async fn sync<T: Transport>(
+    session: &mut Session<T>,
+    plan: &[PlannedTarget],
+    options: &MoveOptions,
+) -> Result<(u64, Instant), MoveError> {
+    let shortest = shortest_common_duration(session, plan);
+    let slower = if options.slower.is_finite() { options.slower.max(1.0) } else { 1.0 };
+    let duration =
+        ((shortest as f64 * slower).ceil() as u64).max(options.min_duration.as_millis() as u64);
+    let duration_ms = u16::try_from(duration).map_err(|_| MoveError::TooLong(duration))?;
+    let nodes = node_targets(plan);
+    let link = session.link();
+    let sync = Sync { duration_ms };
+    // Targets are not answered: resend a node's until its heartbeat shows them staged (lost
+    // frames), then SYNC until no heartbeat shows them still staged. After the last attempt
+    // the move goes on; a refusal shows as a warning event and a miss in the report.
+    let mut pending = nodes.clone();
+    for _ in 0..=CONFIRM_RETRIES {
+        let sent = Instant::now();
+        for packet in
+            packets(&pending, sync, link).filter(|p| !matches!(p.message, Message::Sync(_)))
+        {
+            session.send(packet).await?;
+        }
+        let confirmed = |s: &Session<T>, n: &NodeTargets| staged(s, n, sent) == Some(true);
+        session
+            .wait_until(sent + CONFIRM_TIMEOUT, |s| pending.iter().all(|n| confirmed(s, n)))
+            .await?;
+        pending.retain(|n| !confirmed(session, n));
+        if pending.is_empty() {
+            break;
+        }
+    }
+    let mut sent = Instant::now();
+    for _ in 0..=CONFIRM_RETRIES {
+        sent = Instant::now();
+        session.send(Packet::broadcast(Message::Sync(sync))).await?;
+        let started = |s: &Session<T>| nodes.iter().all(|n| staged(s, n, sent) == Some(false));
+        if session.wait_until(sent + CONFIRM_TIMEOUT, started).await? {
+            break;
+        }
+    }
+    Ok((duration, sent))
+}
+
+/// How many times targets and SYNC are resent when heartbeats do not confirm them.
+const CONFIRM_RETRIES: usize = 3;
+/// How long to wait for heartbeats confirming targets or SYNC (two heartbeat periods).
+const CONFIRM_TIMEOUT: Duration = Duration::from_millis(250);
+
+/// Whether a heartbeat of `n`'s node received after `since` shows its targets staged
+/// (`None`: no such heartbeat yet).
+fn staged<T: Transport>(session: &Session<T>, n: &NodeTargets, since: Instant) -> Option<bool> {
+    let status = session.nodes().get(&n.node)?;
+    let heartbeat = status.heartbeat.filter(|_| status.heartbeat_at.is_some_and(|t| t > since))?;
+    let wanted = n.targets.iter().enumerate().filter(|(_, t)| t.is_some());
+    Some(
+        wanted.clone().count() > 0
+            && wanted
+                .into_iter()
+                .all(|(i, _)| Actuator::new(i as u8).is_some_and(|a| heartbeat.staged.contains(a))),
+    )
+}
+
+fn position_mm<T: Transport>(session: &Session<T>, t: &PlannedTarget) -> Option<f64> {
+    let p = session.nodes().get(&t.node)?.positions[t.actuator.index()]?;
+    Some(f64::from(p.hundredths_mm()) / 100.0)
+}
+
+fn within<T: Transport>(session: &Session<T>, t: &PlannedTarget, tolerance_mm: f64) -> bool {
+    position_mm(session, t).is_some_and(|p| (p - t.target.mm()).abs() <= tolerance_mm + 1e-9)
+}
+
+/// Every actuator of `plan` is within tolerance and at rest (its node's heartbeat shows it
+/// not moving).
+fn all_within<T: Transport>(
+    session: &Session<T>,
+    plan: &[PlannedTarget],
+    tolerance_mm: f64,
+) -> bool {
+    plan.iter().all(|t| {
+        let resting = session
+            .nodes()
+            .get(&t.node)
+            .and_then(|s| s.heartbeat)
+            .is_some_and(|h| !h.moving.contains(t.actuator));
+        resting && within(session, t, tolerance_mm)
+    })
+}
+
+fn progress_of<T: Transport>(
+    session: &Session<T>,
+    plan: &[PlannedTarget],
+    tolerance_mm: f64,
+    elapsed: Duration,
+    duration: Duration,
+) -> Progress {
+    let mut nodes: BTreeMap<NodeId, NodeProgress> = BTreeMap::new();
+    for t in plan {
+        let entry = nodes.entry(t.node).or_insert_with(|| NodeProgress {
+            node: t.node.get(),
+            label: session
+                .form()
+                .nodes
+                .iter()
+                .find(|n| n.address == t.node.get())
+                .and_then(|n| n.label.clone())
+                .unwrap_or_else(|| format!("node {}", t.node.get())),
+            within: 0,
+            total: 0,
+            worst_mm: Some(0.0),
+        });
+        entry.total += 1;
+        if within(session, t, tolerance_mm) {
+            entry.within += 1;
+        }
+        let remaining = position_mm(session, t).map(|p| (p - t.target.mm()).abs());
+        entry.worst_mm = match (entry.worst_mm, remaining) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            _ => None,
+        };
+    }
+    Progress { nodes: nodes.into_values().collect(), elapsed, duration }
+}
+
+/// The first fault among the nodes' events (warnings are kept in `warnings`), or a node in
+/// Fault.
+fn fault<T: Transport>(
+    session: &mut Session<T>,
+    plan: &[PlannedTarget],
+    warnings: &mut Vec<String>,
+) -> Option<MoveError> {
+    let nodes: Vec<NodeId> = session.nodes().keys().copied().collect();
+    let mut found = None;
+    for node in nodes {
+        let events =
+            session.node_mut(node).map(|s| std::mem::take(&mut s.events)).unwrap_or_default();
+        let state = session.nodes().get(&node).and_then(|s| s.heartbeat);
+        for e in events {
+            let actuator = e
+                .actuator
+                .and_then(|a| session.form().actuator_at(node, a).map(|spec| spec.id.clone()));
+            let is_fault = !e.code.fault().is_empty()
+                || (e.code != EmergencyCode::NO_ERROR
+                    && state.is_some_and(|h| h.state == DriveState::Fault));
+            if is_fault && found.is_none() {
+                found = Some(MoveError::Fault {
+                    node: node.get(),
+                    actuator,
+                    code: e.code.0,
+                    code_name: code_name(e.code),
+                    detail: e.detail,
+                });
+            } else if !is_fault && e.code != EmergencyCode::NO_ERROR {
+                let target = actuator.as_deref().unwrap_or("the node");
+                warnings.push(format!(
+                    "node {}, {target}: {} (detail {})",
+                    node.get(),
+                    code_name(e.code),
+                    e.detail
+                ));
+            }
+        }
+        if found.is_none()
+            && let Some(h) = state
+            && h.state == DriveState::Fault
+            && plan.iter().any(|t| t.node == node)
+        {
+            found = Some(MoveError::Fault {
+                node: node.get(),
+                actuator: None,
+                code: 0,
+                code_name: format!("node in Fault, flags {:?}", h.faults),
+                detail: 0,
+            });
+        }
+    }
+    found
+}

@@ -1,0 +1,123 @@
+//! A serial device shared by the serial and slcan links: `serialport` opens it (a USB
+//! adapter or a pseudo-terminal alike); a reader thread turns the bytes into packets with the
+//! link's parser and hands them to tokio through a channel; writes are small (at most a
+//! frame) and go straight to the port.
+
+use std::io::{ErrorKind, Read, Write};
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use firmware_protocol::Packet;
+use serialport::SerialPort;
+use tokio::sync::mpsc;
+
+use super::TransportError;
+
+/// How long a read waits before the reader checks whether it should stop.
+const READ_TIMEOUT: Duration = Duration::from_millis(10);
+
+/// An open serial device with its reader thread.
+pub struct Line {
+    device: String,
+    writer: Box<dyn SerialPort>,
+    packets: mpsc::UnboundedReceiver<Result<Packet, String>>,
+    stop: Arc<AtomicBool>,
+    reader: Option<std::thread::JoinHandle<()>>,
+}
+
+impl std::fmt::Debug for Line {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Line").field("device", &self.device).finish_non_exhaustive()
+    }
+}
+
+impl Line {
+    /// Opens `path` at `baud` (8N1) and starts reading with `parse`, which turns each chunk
+    /// of bytes into the packets it completes.
+    pub fn open(
+        path: &Path,
+        baud: u32,
+        mut parse: impl FnMut(&[u8], &mut Vec<Packet>) + Send + 'static,
+    ) -> Result<Self, TransportError> {
+        let device = path.display().to_string();
+        let io = |source| TransportError::Io { device: device.clone(), source };
+        let writer = serialport::new(device.clone(), baud)
+            .timeout(READ_TIMEOUT)
+            .open()
+            .map_err(|e| io(std::io::Error::from(e)))?;
+        let mut reader = writer.try_clone().map_err(|e| io(std::io::Error::from(e)))?;
+        let (tx, packets) = mpsc::unbounded_channel();
+        let stop = Arc::new(AtomicBool::new(false));
+        let stopping = Arc::clone(&stop);
+        let reader = std::thread::Builder::new()
+            .name(format!("dressform reader {device}"))
+            .spawn(move || {
+                let mut buf = [0u8; 1024];
+                let mut parsed = Vec::new();
+                while !stopping.load(Ordering::Relaxed) {
+                    match reader.read(&mut buf) {
+                        Ok(0) => std::thread::sleep(READ_TIMEOUT),
+                        Ok(n) => {
+                            parse(&buf[..n], &mut parsed);
+                            for packet in parsed.drain(..) {
+                                if tx.send(Ok(packet)).is_err() {
+                                    return;
+                                }
+                            }
+                        }
+                        Err(e)
+                            if matches!(
+                                e.kind(),
+                                ErrorKind::TimedOut
+                                    | ErrorKind::Interrupted
+                                    | ErrorKind::WouldBlock
+                            ) => {}
+                        Err(e) => {
+                            let _ = tx.send(Err(e.to_string()));
+                            return;
+                        }
+                    }
+                }
+            })
+            .map_err(io)?;
+        Ok(Self { device, writer, packets, stop, reader: Some(reader) })
+    }
+
+    /// The device path.
+    pub fn device(&self) -> String {
+        self.device.clone()
+    }
+
+    /// Writes `bytes` in full.
+    pub fn write(&mut self, bytes: &[u8]) -> Result<(), TransportError> {
+        self.writer
+            .write_all(bytes)
+            .and_then(|()| self.writer.flush())
+            .map_err(|source| TransportError::Io { device: self.device.clone(), source })
+    }
+
+    /// The next packet the reader parsed.
+    pub async fn recv(&mut self) -> Result<Packet, TransportError> {
+        match self.packets.recv().await {
+            Some(Ok(packet)) => Ok(packet),
+            Some(Err(message)) => Err(TransportError::Io {
+                device: self.device.clone(),
+                source: std::io::Error::other(message),
+            }),
+            None => Err(TransportError::Closed(self.device.clone())),
+        }
+    }
+}
+
+impl Drop for Line {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        // The reader's handle closes with it (releasing the port's exclusive lock) within
+        // one read timeout; wait, so the port can be opened again at once.
+        if let Some(reader) = self.reader.take() {
+            let _ = reader.join();
+        }
+    }
+}

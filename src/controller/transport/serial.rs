@@ -1,0 +1,63 @@
+//! The protocol's serial mapping on a serial port (1 Mbaud 8N1): every packet is a frame
+//! `address, sequence, code, payload, CRC-16`, COBS-encoded and ended by `0x00`
+//! (`firmware_protocol::serial`).
+//!
+//! Packet handling: the host numbers its requests; sending the same packet again (a retry)
+//! reuses its number, as the protocol asks. Received frames that fail to decode are dropped
+//! (the decoder resynchronises at the next `0x00`). Nodes on a serial line speak only when
+//! polled, which the session does ([`Link::Serial`]).
+
+use std::path::Path;
+
+use firmware_protocol::{Link, Packet, serial};
+
+use super::line::Line;
+use super::{Transport, TransportError};
+
+/// The line speed of the serial mapping.
+pub const BAUD: u32 = 1_000_000;
+
+/// A serial port speaking the serial mapping.
+#[derive(Debug)]
+pub struct SerialLine {
+    line: Line,
+    seq: u8,
+    last: Option<Packet>,
+}
+
+impl SerialLine {
+    /// Opens the port and flushes the nodes' partial frame with a lone `0x00`.
+    pub fn open(path: &Path) -> Result<Self, TransportError> {
+        let mut decoder = serial::Decoder::new();
+        let mut line = Line::open(path, BAUD, move |bytes, out| {
+            out.extend(decoder.feed(bytes).filter_map(Result::ok).map(|frame| frame.packet));
+        })?;
+        line.write(&[0])?;
+        Ok(Self { line, seq: 0, last: None })
+    }
+}
+
+impl Transport for SerialLine {
+    fn link(&self) -> Link {
+        Link::Serial
+    }
+
+    fn device(&self) -> String {
+        self.line.device()
+    }
+
+    async fn send(&mut self, packet: Packet) -> Result<(), TransportError> {
+        if self.last != Some(packet) {
+            self.seq = self.seq.wrapping_add(1);
+            self.last = Some(packet);
+        }
+        let wire = serial::encode(&serial::Frame { seq: self.seq, packet }).map_err(|e| {
+            TransportError::Unsupported { device: self.device(), what: format!("{packet:?}: {e}") }
+        })?;
+        self.line.write(&wire)
+    }
+
+    async fn recv(&mut self) -> Result<Packet, TransportError> {
+        self.line.recv().await
+    }
+}

@@ -1,0 +1,200 @@
+//! The set-point file: where every actuator of a form should be, in millimetres.
+//!
+//! ```json
+//! {
+//!   "format": "dressform-setpoints/1",
+//!   "form": "reference",
+//!   "positions_mm": { "chest-l1": 23.5, "chest-front": 12.0 }
+//! }
+//! ```
+//!
+//! * `format` is exactly `dressform-setpoints/1`;
+//! * `form` is the `name` of the form description the file was made for;
+//! * `positions_mm` maps an actuator id of that form to its extension in mm from the home
+//!   (fully retracted) end. Actuators the file leaves out stay where they are.
+//!
+//! Loading refuses an unknown actuator id, a non-finite value or another form's name, naming
+//! the file and the field or actuator. [`SetPoints::check`] then refuses positions outside
+//! `[0, stroke]` with the list of offenders, or clamps them into the stroke and reports them
+//! (`--clamp`); only a [`Checked`] set of targets can be driven.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use sim::form::FormDescription;
+
+use crate::controller::safety::SafeTarget;
+use crate::output::{WriteError, write_atomically};
+
+/// The `format` of the files this module reads and writes.
+pub const FORMAT: &str = "dressform-setpoints/1";
+
+/// A set-point file's content.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SetPoints {
+    /// Always [`FORMAT`].
+    pub format: String,
+    /// The form's name.
+    pub form: String,
+    /// Actuator id → extension from home, mm.
+    pub positions_mm: BTreeMap<String, f64>,
+}
+
+/// Why a set-point file cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum SetPointsError {
+    /// It cannot be read.
+    #[error("{}: cannot read: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// It is not a set-point file.
+    #[error("{}: not a set-point file: {message}", path.display())]
+    Syntax {
+        /// The file.
+        path: PathBuf,
+        /// What the JSON parser said (with line and column).
+        message: String,
+    },
+    /// It is a set-point file, but not one for this form.
+    #[error("{}: {}", path.display(), problems.join("; "))]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// Every problem, each naming the field or the actuator.
+        problems: Vec<String>,
+    },
+    /// It cannot be written.
+    #[error(transparent)]
+    Write(#[from] WriteError),
+}
+
+/// Positions outside their actuator's stroke, refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("positions outside the stroke: {}", list(offending))]
+pub struct OutOfStroke {
+    /// `(actuator id, asked mm, stroke mm)`, in id order.
+    pub offending: Vec<(String, f64, f64)>,
+}
+
+fn list(offending: &[(String, f64, f64)]) -> String {
+    let items: Vec<String> = offending
+        .iter()
+        .map(|(id, asked, stroke)| format!("{id} asks {asked} mm (stroke 0..={stroke} mm)"))
+        .collect();
+    items.join(", ")
+}
+
+/// Set-points checked against a form: every target lies within its actuator's stroke.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Checked {
+    /// Actuator id → its target, in id order.
+    pub targets: BTreeMap<String, SafeTarget>,
+    /// Positions clamped into the stroke (`--clamp`): `(id, asked mm, used mm)`.
+    pub clamped: Vec<(String, f64, f64)>,
+}
+
+impl SetPoints {
+    /// Set-points for the form named `form` (format [`FORMAT`]).
+    pub fn new(form: impl Into<String>, positions_mm: BTreeMap<String, f64>) -> Self {
+        Self { format: FORMAT.to_string(), form: form.into(), positions_mm }
+    }
+
+    /// Parses set-point JSON; `path` names the source in errors. Checks the format and that
+    /// every value is a finite number; [`SetPoints::validate`] checks it against a form.
+    pub fn from_json_str(text: &str, path: &Path) -> Result<Self, SetPointsError> {
+        let syntax = |e: serde_json::Error| SetPointsError::Syntax {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        };
+        // Non-finite numbers are not JSON; anything else wrong is named by serde.
+        let points: SetPoints = serde_json::from_str(text).map_err(syntax)?;
+        if points.format != FORMAT {
+            return Err(SetPointsError::Invalid {
+                path: path.to_path_buf(),
+                problems: vec![format!(
+                    "format: expected \"{FORMAT}\", found \"{}\"",
+                    points.format
+                )],
+            });
+        }
+        Ok(points)
+    }
+
+    /// Reads and checks a set-point file against `form` (see [`SetPoints::validate`]).
+    pub fn load(path: &Path, form: &FormDescription) -> Result<Self, SetPointsError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| SetPointsError::Read { path: path.to_path_buf(), source })?;
+        let points = Self::from_json_str(&text, path)?;
+        points
+            .validate(form)
+            .map_err(|problems| SetPointsError::Invalid { path: path.to_path_buf(), problems })?;
+        Ok(points)
+    }
+
+    /// Every problem with using these set-points on `form`: another form's name, unknown
+    /// actuator ids, non-finite values.
+    pub fn validate(&self, form: &FormDescription) -> Result<(), Vec<String>> {
+        let mut problems = Vec::new();
+        if self.form != form.name {
+            problems.push(format!(
+                "form: the file is for \"{}\", the form is \"{}\"",
+                self.form, form.name
+            ));
+        }
+        for (id, &mm) in &self.positions_mm {
+            if form.actuator(id).is_none() {
+                problems.push(format!("positions_mm.{id}: the form has no actuator \"{id}\""));
+            } else if !mm.is_finite() {
+                problems.push(format!("positions_mm.{id}: {mm} is not a finite number"));
+            }
+        }
+        if problems.is_empty() { Ok(()) } else { Err(problems) }
+    }
+
+    /// The JSON text of the file (pretty-printed, ending with a newline).
+    pub fn to_json_string(&self) -> String {
+        let mut text = serde_json::to_string_pretty(self).unwrap_or_default();
+        text.push('\n');
+        text
+    }
+
+    /// Writes the file atomically.
+    pub fn save(&self, path: &Path) -> Result<(), SetPointsError> {
+        Ok(write_atomically(path, self.to_json_string().as_bytes())?)
+    }
+
+    /// The targets on `form`: every position must lie in `[0, stroke]`, else the offenders
+    /// are refused, or clamped into the stroke and listed when `clamp` holds. Unknown ids
+    /// and non-finite values (which [`SetPoints::validate`] refuses) are offenders too.
+    pub fn check(&self, form: &FormDescription, clamp: bool) -> Result<Checked, OutOfStroke> {
+        let mut checked = Checked { targets: BTreeMap::new(), clamped: Vec::new() };
+        let mut offending = Vec::new();
+        for (id, &asked) in &self.positions_mm {
+            let Some(spec) = form.actuator(id) else {
+                offending.push((id.clone(), asked, f64::NAN));
+                continue;
+            };
+            let stroke = spec.stroke();
+            match SafeTarget::within(asked, stroke) {
+                Some(target) => {
+                    checked.targets.insert(id.clone(), target);
+                }
+                None if clamp && !asked.is_nan() => {
+                    let target = SafeTarget::clamped(asked, stroke);
+                    checked.clamped.push((id.clone(), asked, target.mm()));
+                    checked.targets.insert(id.clone(), target);
+                }
+                None => {
+                    offending.push((id.clone(), asked, f64::from(stroke.hundredths_mm()) / 100.0))
+                }
+            }
+        }
+        if offending.is_empty() { Ok(checked) } else { Err(OutOfStroke { offending }) }
+    }
+}

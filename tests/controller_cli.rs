@@ -1,0 +1,75 @@
+//! `dressform drive --sim`, `status --sim` and `estop` from the command line (real time, a
+//! few seconds: homing, then short moves).
+
+use std::process::Command;
+
+fn dressform(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_dressform")).args(args).output().expect("dressform runs")
+}
+
+fn setpoints(dir: &tempfile::TempDir, positions: &str) -> String {
+    let path = dir.path().join("setpoints.json");
+    let text = format!(
+        r#"{{"format": "dressform-setpoints/1", "form": "reference", "positions_mm": {{{positions}}}}}"#
+    );
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn drive_on_the_simulated_form_reports_every_actuator() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = setpoints(&dir, r#""chest-l1": 3.5, "neck-front": 2.0"#);
+    let form = concat!(env!("CARGO_MANIFEST_DIR"), "/sim/forms/reference.toml");
+    let out = dressform(&["drive", &file, "--form", form, "--sim", "--json"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let actuators = report["actuators"].as_array().unwrap();
+    assert_eq!(actuators.len(), 2);
+    for a in actuators {
+        assert_eq!(a["within_tolerance"], true, "{a}");
+        assert!(a["error_mm"].as_f64().unwrap().abs() <= 0.1, "{a}");
+    }
+}
+
+#[test]
+fn an_out_of_stroke_file_is_refused_with_its_offenders_or_clamped() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = setpoints(&dir, r#""chest-l1": 75, "neck-front": -2, "hip-back": 1"#);
+    let out = dressform(&["drive", &file, "--sim"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("chest-l1 asks 75 mm (stroke 0..=60 mm)"), "{stderr}");
+    assert!(stderr.contains("neck-front asks -2 mm (stroke 0..=25 mm)"), "{stderr}");
+    assert!(!stderr.contains("hip-back"), "{stderr}");
+
+    let file = setpoints(&dir, r#""neck-front": 30"#);
+    let out = dressform(&["drive", &file, "--sim", "--clamp"]);
+    let (stdout, stderr) =
+        (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(
+        stderr.contains("neck-front: 30 mm is outside the stroke, clamped to 25 mm"),
+        "{stderr}"
+    );
+    assert!(stdout.contains("neck-front") && stdout.contains("25.00"), "{stdout}");
+}
+
+#[test]
+fn status_lists_every_node_and_estop_needs_a_link() {
+    let out = dressform(&["status", "--sim"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    for node in 1..=8 {
+        assert!(
+            stdout.contains(&format!("node {node}: Disabled (protocol 1.0, firmware 1.0.0)")),
+            "{stdout}"
+        );
+    }
+    let out = dressform(&["estop"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = dressform(&["estop", "--serial", "/dev/does-not-exist"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/dev/does-not-exist"));
+}

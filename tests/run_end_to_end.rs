@@ -1,0 +1,71 @@
+//! `dressform run` end to end, as in a studio: a synthetic customer's scan file, the simulated
+//! reference form served on a real pseudo-terminal (serial mapping, or slcan as behind a USB-CAN
+//! adapter), and the `dressform` binary opening that device — then the simulated actuators are
+//! checked against the set-points the run wrote.
+
+use dressform::mesh::Mesh;
+use dressform::scan::format::Format;
+use dressform::setpoints::SetPoints;
+use glam::DVec3;
+use sim::capture::{Artifacts, BodyParams, capture, generate};
+use sim::form::reference;
+use sim::serve::{ServeConfig, Transport, serve};
+
+fn scan_file(dir: &std::path::Path) -> std::path::PathBuf {
+    let body = generate(&BodyParams::default()).unwrap();
+    let raw = capture(&body, &Artifacts::typical_scanner(2));
+    let mesh =
+        Mesh::new(raw.positions.iter().map(|&p| DVec3::from_array(p)).collect(), raw.triangles);
+    let path = dir.join("scan.ply");
+    std::fs::write(&path, Format::Ply.encode(&mesh)).unwrap();
+    path
+}
+
+fn run_over(transport: Transport, flag: &str) {
+    let tmp = tempfile::tempdir().unwrap();
+    let scan = scan_file(tmp.path());
+    let runtime =
+        tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
+    let server = {
+        let _context = runtime.enter();
+        serve(ServeConfig::new(reference(), transport)).unwrap()
+    };
+    let out = tmp.path().join("out");
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_dressform"))
+        .args(["run", scan.to_str().unwrap(), flag, server.device_path().to_str().unwrap()])
+        .args(["--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{flag}: {}\n{stdout}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(stdout.contains("every actuator reached its set-point"), "{stdout}");
+
+    let form = reference();
+    let setpoints = SetPoints::load(&out.join("setpoints.json"), &form).unwrap();
+    assert_eq!(setpoints.positions_mm.len(), form.actuators.len());
+    let truth = server.form().state();
+    for (id, &mm) in &setpoints.positions_mm {
+        let real = truth.actuator(id).unwrap().state.position_mm;
+        assert!(
+            (real - mm).abs() <= 0.1,
+            "{flag} {id}: the simulated panel is at {real:.3} mm, set-point {mm:.3}"
+        );
+    }
+    for name in ["mannequin.obj", "profiles.json", "measurements.json"] {
+        assert!(out.join(name).is_file(), "{name}");
+    }
+}
+
+#[test]
+fn run_shapes_the_form_over_a_serial_pty() {
+    run_over(Transport::SerialPty, "--serial");
+}
+
+#[test]
+fn run_shapes_the_form_over_slcan() {
+    run_over(Transport::SlcanPty, "--slcan");
+}
