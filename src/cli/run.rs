@@ -13,6 +13,7 @@ use dressform::mesh::topology;
 use dressform::output::write_atomically;
 use dressform::pipeline::{STEPS, Symmetrized, symmetrize};
 use dressform::profiles::Profiles;
+use dressform::regions::Region;
 use dressform::scan::{self, Scan, format::Format};
 use dressform::setpoints::SetPoints;
 use sim::form::FormDescription;
@@ -136,10 +137,27 @@ fn girth_table(
         "  {:<12} {:>9} {:>9} {:>11} {:>9}",
         "girth (mm)", "body z", "scan", "mannequin", "form"
     );
+    // The scan's sections: one sweep per region for all its rings.
+    let mut scanned: BTreeMap<String, String> = BTreeMap::new();
+    for region in [Region::Torso, Region::LeftLeg, Region::RightLeg] {
+        let rings: Vec<(&str, f64)> = form
+            .rings
+            .iter()
+            .zip(&fitted.rings)
+            .filter(|(ring, _)| region_of(ring) == region)
+            .map(|(ring, r)| (ring.name.as_str(), r.mannequin_height_mm))
+            .collect();
+        let heights: Vec<f64> = rings.iter().map(|r| r.1).collect();
+        for ((name, _), c) in
+            rings.iter().zip(result.regions.sections_of(&scan.body, region, &heights))
+        {
+            let girth = c.map_or_else(|| "-".to_string(), |c| format!("{:.1}", c.tape_girth()));
+            scanned.insert(name.to_string(), girth);
+        }
+    }
     for (ring, r) in form.rings.iter().zip(&fitted.rings) {
         let z = r.mannequin_height_mm;
-        let scanned = result.regions.sections_of(&scan.body, region_of(ring), &[z]).pop().flatten();
-        let scanned = scanned.map_or_else(|| "-".to_string(), |c| format!("{:.1}", c.tape_girth()));
+        let scanned = &scanned[&ring.name];
         let _ = writeln!(
             s,
             "  {:<12} {:>9.0} {:>9} {:>11.1} {:>9.1}",
