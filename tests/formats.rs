@@ -153,3 +153,63 @@ fn obj_quads_and_groups_are_read_and_triangulated() {
     let mesh = Format::Obj.read(text.as_bytes()).unwrap();
     assert_eq!(mesh.triangles.len(), 3);
 }
+
+/// A little-endian binary PLY as scanners write it: `float` coordinates with a colour byte,
+/// and faces with a flag byte before a `uchar int` index list. Each face is a list of indices.
+fn scanner_ply(positions: &[DVec3], faces: &[Vec<i32>]) -> Vec<u8> {
+    let mut bytes = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\nproperty float y\n\
+         property float z\nproperty uchar red\nelement face {}\nproperty uchar flags\n\
+         property list uchar int vertex_indices\nend_header\n",
+        positions.len(),
+        faces.len()
+    )
+    .into_bytes();
+    for p in positions {
+        for c in p.to_array() {
+            bytes.extend((c as f32).to_le_bytes());
+        }
+        bytes.push(200);
+    }
+    for f in faces {
+        bytes.push(7);
+        bytes.push(f.len() as u8);
+        for i in f {
+            bytes.extend(i.to_le_bytes());
+        }
+    }
+    bytes
+}
+
+#[test]
+fn binary_ply_with_extra_properties_reads_triangles_and_polygons() {
+    let mesh = sample().map_positions(|p| p.as_vec3().as_dvec3());
+    let faces: Vec<Vec<i32>> =
+        mesh.triangles.iter().map(|t| t.iter().map(|&i| i as i32).collect()).collect();
+    assert_eq!(Format::Ply.read(&scanner_ply(&mesh.positions, &faces)).unwrap(), mesh);
+
+    // One quad among the triangles: faces no longer have one size.
+    let mut mixed = faces.clone();
+    mixed[1] = vec![0, 2, 3, 4];
+    let back = Format::Ply.read(&scanner_ply(&mesh.positions, &mixed)).unwrap();
+    assert_eq!(back.triangles.len(), mesh.triangles.len() + 1);
+    assert_eq!(&back.triangles[1..3], &[[0, 2, 3], [0, 3, 4]]);
+}
+
+#[test]
+fn binary_ply_face_index_out_of_range_names_the_face_and_the_index() {
+    let mesh = sample();
+    let mut faces: Vec<Vec<i32>> =
+        mesh.triangles.iter().map(|t| t.iter().map(|&i| i as i32).collect()).collect();
+    for (bad, expected) in [(99, "face 5 refers to vertex 99"), (-1, "face 5 refers to vertex -1")]
+    {
+        faces[5][2] = bad;
+        let err = Format::Ply.read(&scanner_ply(&mesh.positions, &faces)).unwrap_err();
+        assert!(err.to_string().contains(expected), "{err}");
+        // The same with faces of mixed sizes (read one by one).
+        let mut mixed = faces.clone();
+        mixed[0].push(4);
+        let err = Format::Ply.read(&scanner_ply(&mesh.positions, &mixed)).unwrap_err();
+        assert!(err.to_string().contains(expected), "{err}");
+    }
+}

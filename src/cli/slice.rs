@@ -3,7 +3,7 @@
 use super::{Failure, FrameArgs, warn};
 use dressform::regions::{BodyRegions, Region, TRACKING_STEP_MM};
 use dressform::scan;
-use dressform::slice::sections;
+use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -52,24 +52,24 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
     for w in scan.cleaning.warnings() {
         warn(&file, &w);
     }
-    let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM)
-        .map_err(|e| warn(&file, &format!("loops are not labelled: {e}")))
-        .ok();
+    let (regions, sections) =
+        BodyRegions::find_and_cut(&scan.body, TRACKING_STEP_MM, &args.heights);
+    let regions = regions.map_err(|e| warn(&file, &format!("loops are not labelled: {e}"))).ok();
+    for s in sections.iter().filter(|s| s.bridged_gaps > 0) {
+        warn(
+            &file,
+            &format!(
+                "closed {} open loops at z = {:.1} mm (holes in the scan)",
+                s.bridged_gaps, s.height
+            ),
+        );
+    }
     let out = SliceOut {
         file: file.clone(),
-        sections: sections(&scan.body, &args.heights)
-            .into_iter()
+        sections: sections
+            .into_par_iter()
             .map(|s| {
                 let labels = regions.as_ref().map(|r| r.label(&s));
-                if s.bridged_gaps > 0 {
-                    warn(
-                        &file,
-                        &format!(
-                            "closed {} open loops at z = {:.1} mm (holes in the scan)",
-                            s.bridged_gaps, s.height
-                        ),
-                    );
-                }
                 SectionOut {
                     z_mm: s.height,
                     bridged_gaps: s.bridged_gaps,

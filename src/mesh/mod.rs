@@ -9,10 +9,12 @@ pub mod smooth;
 mod topology;
 mod weld;
 
-pub use components::{Component, Components, components};
+pub use components::{Component, Components, NO_PIECE, components};
 pub use topology::{Topology, topology};
 
 use glam::DVec3;
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 
 /// An indexed triangle mesh. Triangles are counter-clockwise seen from outside.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -82,7 +84,10 @@ impl Mesh {
         if self.triangles.is_empty() {
             return None;
         }
-        Aabb::around(self.positions.iter().copied())
+        self.positions
+            .par_chunks(1 << 14)
+            .filter_map(|block| Aabb::around(block.iter().copied()))
+            .reduce_with(|a, b| Aabb { min: a.min.min(b.min), max: a.max.max(b.max) })
     }
 
     /// Signed volume enclosed (positive for a closed, outward-oriented mesh).
@@ -120,28 +125,58 @@ impl Mesh {
         self.drop_unused_vertices();
     }
 
+    /// The part of the mesh made of the triangles for which `keep` is true, with only the
+    /// vertices they use (in order of first use).
+    pub fn part(&self, keep: impl Fn([u32; 3]) -> bool + Sync) -> Mesh {
+        let mut triangles: Vec<[u32; 3]> =
+            self.triangles.par_iter().copied().filter(|&tri| keep(tri)).collect();
+        let mut index: FxHashMap<u32, u32> = FxHashMap::default();
+        let mut positions = Vec::new();
+        for v in triangles.iter_mut().flatten() {
+            *v = *index.entry(*v).or_insert_with(|| {
+                positions.push(self.positions[*v as usize]);
+                positions.len() as u32 - 1
+            });
+        }
+        Mesh { positions, triangles }
+    }
+
     /// Removes vertices no triangle refers to, keeping the others in their order.
     pub fn drop_unused_vertices(&mut self) {
-        let mut used = vec![false; self.positions.len()];
-        for &i in self.triangles.iter().flatten() {
-            used[i as usize] = true;
-        }
-        if used.iter().all(|&u| u) {
+        // One bit per vertex, set in parallel over blocks of triangles, then merged.
+        let words = self.positions.len().div_ceil(64);
+        let used = self
+            .triangles
+            .par_chunks(1 << 16)
+            .fold(
+                || vec![0u64; words],
+                |mut used, block| {
+                    for &i in block.iter().flatten() {
+                        used[i as usize / 64] |= 1 << (i % 64);
+                    }
+                    used
+                },
+            )
+            .reduce(
+                || vec![0u64; words],
+                |mut a, b| {
+                    a.iter_mut().zip(b).for_each(|(x, y)| *x |= y);
+                    a
+                },
+            );
+        let is_used = |i: usize| used[i / 64] & (1 << (i % 64)) != 0;
+        if (0..self.positions.len()).all(is_used) {
             return;
         }
         let mut new_index = vec![u32::MAX; self.positions.len()];
         let mut next = 0;
-        for (i, &u) in used.iter().enumerate() {
-            if u {
-                new_index[i] = next;
-                self.positions[next as usize] = self.positions[i];
-                next += 1;
-            }
+        for i in (0..self.positions.len()).filter(|&i| is_used(i)) {
+            new_index[i] = next;
+            self.positions[next as usize] = self.positions[i];
+            next += 1;
         }
         self.positions.truncate(next as usize);
-        for tri in &mut self.triangles {
-            *tri = tri.map(|i| new_index[i as usize]);
-        }
+        self.triangles.par_iter_mut().for_each(|tri| *tri = tri.map(|i| new_index[i as usize]));
     }
 
     /// Merges vertices with bit-identical positions; returns how many were merged away.

@@ -120,7 +120,25 @@ pub const TRACKING_STEP_MM: f64 = 5.0;
 impl BodyRegions {
     /// Segments `body` (canonical frame), tracking loops every `step` mm.
     pub fn find(body: &Mesh, step: f64) -> Result<BodyRegions, RegionError> {
-        tracking::track(body, step)
+        Self::find_and_cut(body, step, &[]).0
+    }
+
+    /// [`Self::find`], and the sections of `body` at `heights`, cut in the same sweep as the
+    /// tracking levels (returned whether or not segmentation succeeds).
+    pub fn find_and_cut(
+        body: &Mesh,
+        step: f64,
+        heights: &[f64],
+    ) -> (Result<BodyRegions, RegionError>, Vec<Section>) {
+        let Some(bounds) = body.bounds() else {
+            return (Err(RegionError::NoTorso { z: 0.0 }), sections(body, heights));
+        };
+        let (floor, height) = (bounds.min.z, bounds.size().z);
+        let n = ((height / step).floor() as usize).max(1);
+        let levels: Vec<f64> = (0..n).map(|i| floor + step * (i as f64 + 0.5)).collect();
+        let mut cut = sections(body, &[&levels[..], heights].concat());
+        let requested = cut.split_off(n);
+        (tracking::track(body, step, floor, height, cut), requested)
     }
 
     /// The torso's section at each of `heights` (`None` where there is none): the largest

@@ -2,8 +2,9 @@
 
 use super::{BodyRegions, LabelledSection, Landmarks, Region, RegionError, side};
 use crate::mesh::Mesh;
-use crate::slice::{Contour, Section, sections, sections_among};
+use crate::slice::{Contour, Section, sections};
 use glam::DVec2;
+use rayon::prelude::*;
 
 /// A jump of the torso's half-width between two levels that means an arm has joined (mm).
 const ARM_JOIN_JUMP_MM: f64 = 15.0;
@@ -43,32 +44,31 @@ fn x_range(c: &Contour) -> (f64, f64) {
 }
 
 /// The crotch between `below` (legs apart) and `above` (one torso loop around `inside`), by
-/// bisection to 0.1 mm, cutting only the triangles between the two heights.
+/// bisection to 0.1 mm, cutting only the part of the body between the two heights.
 fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, inside: DVec2) -> f64 {
-    let near: Vec<[u32; 3]> = body
-        .triangles
-        .iter()
-        .filter(|tri| {
-            let z = tri.map(|v| body.positions[v as usize].z);
-            z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
-        })
-        .copied()
-        .collect();
+    let near = body.part(|tri| {
+        let z = tri.map(|v| body.positions[v as usize].z);
+        z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
+    });
     while above - below > 0.1 {
         let mid = 0.5 * (below + above);
-        let s = &sections_among(body, &near, &[mid])[0];
+        let s = &sections(&near, &[mid])[0];
         if loop_containing(s, inside).is_some() { above = mid } else { below = mid }
     }
     above
 }
 
-pub(super) fn track(body: &Mesh, step: f64) -> Result<BodyRegions, RegionError> {
-    let bounds = body.bounds().ok_or(RegionError::NoTorso { z: 0.0 })?;
-    let (floor, height) = (bounds.min.z, bounds.size().z);
-    let n = ((height / step).floor() as usize).max(1);
-    let heights: Vec<f64> = (0..n).map(|i| floor + step * (i as f64 + 0.5)).collect();
-    let sections = sections(body, &heights);
-    let z_of = |i: usize| heights[i];
+/// Tracks loops through `sections`, the body's sections every `step` mm from `floor` (at
+/// `floor + step * (i + 0.5)`) over its `height`.
+pub(super) fn track(
+    body: &Mesh,
+    step: f64,
+    floor: f64,
+    height: f64,
+    sections: Vec<Section>,
+) -> Result<BodyRegions, RegionError> {
+    let n = sections.len();
+    let z_of = |i: usize| floor + step * (i as f64 + 0.5);
 
     let seed = ((0.6 * height / step) as usize).min(n - 1);
     if sections[seed].loops.is_empty() {
@@ -127,23 +127,28 @@ pub(super) fn track(body: &Mesh, step: f64) -> Result<BodyRegions, RegionError> 
     let centre_x = 0.5 * (left_side - right_side);
 
     // Neck: the narrowest torso level between the armpits and the head's widest level.
-    let girth = |&(i, k): &(usize, usize)| sections[i].loops[k].tape_girth();
     let armpit_z = left_armpit.max(right_armpit);
-    let head_widest = up
+    let above_armpits: Vec<(usize, f64)> = up
+        .par_iter()
+        .filter(|&&(i, _)| z_of(i) > armpit_z)
+        .map(|&(i, k)| (i, sections[i].loops[k].tape_girth()))
+        .collect();
+    let head_widest = above_armpits
         .iter()
         .filter(|&&(i, _)| z_of(i) >= floor + 0.87 * height)
-        .max_by(|a, b| girth(a).total_cmp(&girth(b)));
-    let neck = up
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    let neck = above_armpits
         .iter()
-        .filter(|&&(i, _)| z_of(i) > armpit_z && head_widest.is_none_or(|h| i < h.0))
-        .min_by(|a, b| girth(a).total_cmp(&girth(b)))
+        .filter(|&&(i, _)| head_widest.is_none_or(|h| i < h.0))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
         .map_or(armpit_z + 0.5 * (floor + height - armpit_z), |&(i, _)| z_of(i));
 
     // Ankle: the narrowest left-leg level between 3% and 15% of the height.
     let ankle = (0..crotch_i)
+        .into_par_iter()
+        .filter(|&i| (0.03..=0.15).contains(&((z_of(i) - floor) / height)))
         .filter_map(|i| leg[i][0].map(|k| (i, sections[i].loops[k].tape_girth())))
-        .filter(|&(i, _)| (0.03..=0.15).contains(&((z_of(i) - floor) / height)))
-        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
         .map_or(floor + 0.08 * height, |(i, _)| z_of(i));
 
     let landmarks = Landmarks {

@@ -5,7 +5,7 @@
 //! - bit-identical vertices: welded (STL repeats corners; OBJ groups split shared vertices);
 //! - degenerate triangles (repeated corner, zero area): dropped;
 //! - several connected components: the largest by area is the body; floor patches, props and
-//!   noise islands are dropped and listed;
+//!   noise islands are dropped and listed; so are vertices no triangle uses (silently);
 //!
 //! Holes, non-manifold edges and vertices are a diagnosis, not a repair: see
 //! [`crate::mesh::topology`] and [`Topology::warnings`].
@@ -86,22 +86,25 @@ impl CleaningReport {
 
 /// Validates `mesh` and reduces it to the body: see the module documentation.
 pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
-    if let Some((vertex, p)) = mesh.positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
+    if mesh.positions.par_iter().any(|p| !p.is_finite()) {
+        let vertex = mesh.positions.iter().position(|p| !p.is_finite()).unwrap_or(0);
+        let p = mesh.positions[vertex];
         return Err(CleanError::NonFinite { vertex, x: p.x, y: p.y, z: p.z });
     }
     let welded_vertices = mesh.weld_identical();
 
-    let before = mesh.triangles.len();
     let scale = mesh.bounds().map_or(0.0, |b| b.size().length_squared());
-    let keep: Vec<bool> = (0..mesh.triangles.len())
-        .into_par_iter()
-        .map(|t| {
-            let [a, b, c] = mesh.triangles[t];
-            a != b && b != c && a != c && mesh.triangle_area(t) > scale * 1e-16
-        })
-        .collect();
-    mesh.retain_triangles(|t| keep[t]);
-    let degenerate_triangles = before - mesh.triangles.len();
+    let degenerate = |t: usize| {
+        let [a, b, c] = mesh.triangles[t];
+        a == b || b == c || a == c || mesh.triangle_area(t) <= scale * 1e-16
+    };
+    let dropped: Vec<usize> =
+        (0..mesh.triangles.len()).into_par_iter().filter(|&t| degenerate(t)).collect();
+    let degenerate_triangles = dropped.len();
+    if degenerate_triangles > 0 {
+        let mut drop = dropped.into_iter().peekable();
+        mesh.retain_triangles(|t| drop.next_if_eq(&t).is_none());
+    }
     if mesh.triangles.is_empty() {
         return Err(CleanError::AllDegenerate);
     }
@@ -116,8 +119,10 @@ pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
             bounds: c.bounds,
         })
         .collect();
-    if found.parts.len() > 1 {
-        mesh.retain_triangles(|t| found.of_triangle[t] == 0);
+    if !found.is_one_piece() {
+        let body: Vec<bool> =
+            mesh.triangles.par_iter().map(|t| found.of_vertex[t[0] as usize] == 0).collect();
+        mesh.retain_triangles(|t| body[t]);
     }
     let report = CleaningReport {
         welded_vertices,
@@ -126,4 +131,54 @@ pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
         dropped_components,
     };
     Ok((mesh, report))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// An outward tetrahedron scaled by `s` at `at`, as its own vertices and triangles.
+    fn tetrahedron(mesh: &mut Mesh, at: DVec3, s: f64) {
+        let first = mesh.positions.len() as u32;
+        mesh.positions.extend([at, at + DVec3::X * s, at + DVec3::Y * s, at + DVec3::Z * s]);
+        let [a, b, c, d] = [first, first + 1, first + 2, first + 3];
+        mesh.triangles.extend([[a, c, b], [a, b, d], [a, d, c], [b, c, d]]);
+    }
+
+    #[test]
+    fn keeps_the_largest_piece_and_drops_islands_degenerates_and_unused_vertices() {
+        let mut mesh = Mesh::default();
+        tetrahedron(&mut mesh, DVec3::ZERO, 1.0); // an island
+        mesh.positions.push(DVec3::splat(9.0)); // used by no triangle
+        tetrahedron(&mut mesh, DVec3::new(3.0, 0.0, 0.0), 10.0); // the body
+        mesh.triangles.push([5, 5, 6]); // degenerate
+        let (body, report) = clean(mesh).expect("cleans");
+        assert_eq!(body.triangles.len(), 4);
+        assert_eq!(body.positions.len(), 4);
+        assert_eq!(body.positions[0], DVec3::new(3.0, 0.0, 0.0));
+        assert_eq!(report.degenerate_triangles, 1);
+        assert_eq!(report.components, 2);
+        assert_eq!(report.dropped_components.len(), 1);
+        assert_eq!(report.dropped_components[0].triangles, 4);
+        assert!((report.dropped_components[0].area_fraction - 1.0 / 101.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_clean_body_is_left_as_it_is() {
+        let mut mesh = Mesh::default();
+        tetrahedron(&mut mesh, DVec3::ZERO, 2.0);
+        let (body, report) = clean(mesh.clone()).expect("cleans");
+        assert_eq!(body, mesh);
+        assert!(report.warnings().is_empty());
+    }
+
+    #[test]
+    fn a_non_finite_vertex_is_an_error_naming_it() {
+        let mut mesh = Mesh::default();
+        tetrahedron(&mut mesh, DVec3::ZERO, 1.0);
+        mesh.positions[2].y = f64::NAN;
+        let err = clean(mesh).expect_err("rejected");
+        assert!(matches!(err, CleanError::NonFinite { vertex: 2, .. }), "{err}");
+    }
 }

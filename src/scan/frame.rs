@@ -249,28 +249,18 @@ impl Moments {
     }
 }
 
-/// Each triangle's centroid and area, computed once (in parallel).
-fn samples(mesh: &Mesh) -> Vec<(DVec3, f64)> {
-    mesh.triangles
-        .par_iter()
-        .map(|tri| {
-            let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
-            ((a + b + c) / 3.0, 0.5 * (b - a).cross(c - a).length())
-        })
-        .collect()
-}
-
-/// Sums `add(moments, centroid, area)` over all `samples`, in parallel.
+/// Sums `add(moments, centroid, area)` over the triangles of `mesh`, in parallel.
 fn accumulate<const N: usize>(
-    samples: &[(DVec3, f64)],
+    mesh: &Mesh,
     add: impl Fn(&mut [Moments; N], DVec3, f64) + Sync,
 ) -> [Moments; N] {
-    samples
+    mesh.triangles
         .par_iter()
         .fold(
             || [Moments::default(); N],
-            |mut acc, &(p, a)| {
-                add(&mut acc, p, a);
+            |mut acc, tri| {
+                let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+                add(&mut acc, (a + b + c) / 3.0, 0.5 * (b - a).cross(c - a).length());
                 acc
             },
         )
@@ -280,13 +270,11 @@ fn accumulate<const N: usize>(
 /// Finds the canonical frame of `mesh` (a cleaned body), honouring `options`.
 pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, FrameError> {
     let bounds = mesh.bounds().unwrap_or(crate::mesh::Aabb { min: DVec3::ZERO, max: DVec3::ZERO });
-    let samples = samples(mesh);
     let up = match options.up {
         Some(up) => up,
         None => {
             let axis = bounds.size().max_position();
-            let [all] =
-                accumulate(&samples, |m: &mut [Moments; 1], p, a| m[0].add(p, a, DVec2::ZERO));
+            let [all] = accumulate(mesh, |m: &mut [Moments; 1], p, a| m[0].add(p, a, DVec2::ZERO));
             let centroid = all.mean().unwrap_or(bounds.min);
             Direction {
                 axis,
@@ -295,11 +283,8 @@ pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, Fra
         }
     };
     let u = up.vector();
-    let (floor, top) = mesh
-        .positions
-        .iter()
-        .map(|p| p.dot(u))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| (lo.min(h), hi.max(h)));
+    let (floor, top) =
+        (bounds.min.dot(u).min(bounds.max.dot(u)), bounds.min.dot(u).max(bounds.max.dot(u)));
     let height = top - floor;
     let units = match options.units {
         Some(units) => units,
@@ -311,7 +296,7 @@ pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, Fra
     let e1 = Direction { axis: (up.axis + 1) % 3, negative: false }.vector();
     let e2 = Direction { axis: (up.axis + 2) % 3, negative: false }.vector();
     let flat = |p: DVec3| DVec2::new(p.dot(e1), p.dot(e2));
-    let [trunk, feet, shins] = accumulate(&samples, |m: &mut [Moments; 3], p, a| {
+    let [trunk, feet, shins] = accumulate(mesh, |m: &mut [Moments; 3], p, a| {
         let f = (p.dot(u) - floor) / height;
         let band = match f {
             _ if (0.45..=0.75).contains(&f) => 0,

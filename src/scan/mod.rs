@@ -83,13 +83,46 @@ pub fn read_mesh(path: &Path) -> Result<(Mesh, Format), ScanError> {
     let format =
         Format::from_path(path).ok_or_else(|| ScanError::UnknownFormat { path: path.into() })?;
     let bytes =
-        std::fs::read(path).map_err(|source| ScanError::Io { path: path.into(), source })?;
+        FileBytes::open(path).map_err(|source| ScanError::Io { path: path.into(), source })?;
     let mesh = format.read(&bytes).map_err(|error| ScanError::Read {
         path: path.into(),
         format,
         error,
     })?;
     Ok((mesh, format))
+}
+
+/// A file's bytes: mapped into memory where the system allows it, read otherwise.
+///
+/// Mapping a million-triangle scan costs about a tenth of reading it (no copy, and no fresh
+/// memory for the kernel to clear). The catch of any file mapping: if another program
+/// truncates the file while it is being read, the process is stopped by SIGBUS. Scans reach
+/// us as finished files, so the speed is worth it (ripgrep makes the same trade).
+enum FileBytes {
+    Mapped(memmap2::Mmap),
+    Read(Vec<u8>),
+}
+
+impl FileBytes {
+    fn open(path: &Path) -> std::io::Result<FileBytes> {
+        let file = std::fs::File::open(path)?;
+        // SAFETY: the map is read-only and dropped before we return to the caller; see the
+        // type's documentation for what happens if the file shrinks meanwhile.
+        match unsafe { memmap2::Mmap::map(&file) } {
+            Ok(map) => Ok(FileBytes::Mapped(map)),
+            Err(_) => std::fs::read(path).map(FileBytes::Read),
+        }
+    }
+}
+
+impl std::ops::Deref for FileBytes {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        match self {
+            FileBytes::Mapped(map) => map,
+            FileBytes::Read(bytes) => bytes,
+        }
+    }
 }
 
 /// Loads the scan at `path`: read, clean, canonical frame.

@@ -14,7 +14,7 @@ mod contour;
 mod sweep;
 
 pub use contour::{Contour, convex_hull};
-pub use sweep::{sections, sections_among};
+pub use sweep::sections;
 
 /// The loops of one horizontal plane.
 #[derive(Debug, Clone, PartialEq)]

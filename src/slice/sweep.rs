@@ -10,6 +10,7 @@ use super::{Contour, Section};
 use crate::mesh::Mesh;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 
 /// One triangle's piece of one plane: from `start` on edge `from` to `end` on edge `to`.
 #[derive(Debug, Clone, Copy)]
@@ -57,56 +58,54 @@ fn segment(mesh: &Mesh, tri: [u32; 3], h: f64) -> Segment {
 
 /// Cross-sections of `mesh` at each of `heights` (any order; returned in the same order).
 pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
-    sections_among(mesh, &mesh.triangles, heights)
-}
-
-/// Cross-sections of the surface made of `triangles` (indices into `mesh.positions`) only:
-/// for repeated cuts near one height, pass just the triangles there.
-pub fn sections_among(mesh: &Mesh, triangles: &[[u32; 3]], heights: &[f64]) -> Vec<Section> {
     let mut order: Vec<usize> = (0..heights.len()).collect();
     order.sort_by(|&a, &b| heights[a].total_cmp(&heights[b]));
-    let sorted: Vec<f64> = order.iter().map(|&i| heights[i]).collect();
+    let planes = Planes::new(order.iter().map(|&i| heights[i]).collect());
 
-    // Planes crossed by each triangle: zmin < h <= zmax (a vertex on the plane counts as above).
-    let ranges: Vec<(u32, u32)> = triangles
+    // A triangle crosses planes zmin < h <= zmax (a vertex on a plane counts as above it):
+    // those from the fewest to the most planes at or below one of its vertices. So each
+    // vertex is looked up once, and most triangles are dropped after comparing three counts.
+    let below: Vec<u32> =
+        mesh.positions.par_iter().map(|p| planes.at_or_below(p.z) as u32).collect();
+    let crossed: Vec<(u32, u32, u32)> = mesh
+        .triangles
         .par_iter()
-        .map(|tri| {
-            let z = tri.map(|v| mesh.positions[v as usize].z);
-            let (lo, hi) = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
-            (
-                sorted.partition_point(|&h| h <= lo) as u32,
-                sorted.partition_point(|&h| h <= hi) as u32,
-            )
+        .enumerate()
+        .filter_map(|(t, tri)| {
+            let c = tri.map(|v| below[v as usize]);
+            let (first, end) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+            (first < end).then_some((first, end, t as u32))
         })
         .collect();
     // The triangles of each plane, grouped by a counting sort.
-    let mut offsets = vec![0usize; sorted.len() + 1];
-    for &(lo, hi) in &ranges {
-        for k in lo..hi {
+    let n = planes.sorted.len();
+    let mut offsets = vec![0usize; n + 1];
+    for &(first, end, _) in &crossed {
+        for k in first..end {
             offsets[k as usize + 1] += 1;
         }
     }
-    for k in 0..sorted.len() {
+    for k in 0..n {
         offsets[k + 1] += offsets[k];
     }
     let mut fill = offsets.clone();
-    let mut crossing = vec![0u32; offsets[sorted.len()]];
-    for (t, &(lo, hi)) in ranges.iter().enumerate() {
-        for k in lo as usize..hi as usize {
-            crossing[fill[k]] = t as u32;
+    let mut crossing = vec![0u32; offsets[n]];
+    for &(first, end, t) in &crossed {
+        for k in first as usize..end as usize {
+            crossing[fill[k]] = t;
             fill[k] += 1;
         }
     }
 
-    let by_plane: Vec<Section> = (0..sorted.len())
+    let by_plane: Vec<Section> = (0..n)
         .into_par_iter()
         .map(|k| {
-            let h = sorted[k];
-            let mut segments: Vec<Segment> = crossing[offsets[k]..offsets[k + 1]]
+            let h = planes.sorted[k];
+            let segments: Vec<Segment> = crossing[offsets[k]..offsets[k + 1]]
                 .iter()
-                .map(|&t| segment(mesh, triangles[t as usize], h))
+                .map(|&t| segment(mesh, mesh.triangles[t as usize], h))
                 .collect();
-            chain(&mut segments, h)
+            chain(&segments, h)
         })
         .collect();
     let mut out: Vec<Option<Section>> = vec![None; heights.len()];
@@ -116,17 +115,71 @@ pub fn sections_among(mesh: &Mesh, triangles: &[[u32; 3]], heights: &[f64]) -> V
     out.into_iter().flatten().collect()
 }
 
+/// Sorted plane heights, bucketed so that counting the planes at or below a height takes a
+/// table lookup and a search among one or two buckets' planes instead of all of them.
+struct Planes {
+    sorted: Vec<f64>,
+    lowest: f64,
+    /// Buckets per unit of height.
+    scale: f64,
+    /// `first[b]`: the planes at or below the lower edge of bucket `b`.
+    first: Vec<usize>,
+}
+
+impl Planes {
+    fn new(sorted: Vec<f64>) -> Planes {
+        let (lowest, highest) = match (sorted.first(), sorted.last()) {
+            (Some(&lo), Some(&hi)) => (lo, hi),
+            _ => (0.0, 0.0),
+        };
+        let buckets = 4 * sorted.len().min(1 << 14);
+        let scale = if highest > lowest { buckets as f64 / (highest - lowest) } else { 0.0 };
+        let first = (0..=buckets)
+            .map(|b| sorted.partition_point(|&h| (h - lowest) * scale <= b as f64))
+            .collect();
+        Planes { sorted, lowest, scale, first }
+    }
+
+    /// How many planes lie at or below `z`.
+    fn at_or_below(&self, z: f64) -> usize {
+        let n = self.sorted.len();
+        // (A NaN height lies below every plane.)
+        if n == 0 || z.is_nan() || z < self.lowest {
+            return 0;
+        }
+        if z >= self.sorted[n - 1] {
+            return n;
+        }
+        // The bucket of `z`, widened by one on each side against rounding.
+        let b = ((z - self.lowest) * self.scale) as usize;
+        let buckets = self.first.len() - 1;
+        let (from, to) =
+            (self.first[b.saturating_sub(1).min(buckets)], self.first[(b + 2).min(buckets)]);
+        from + self.sorted[from..to].partition_point(|&h| h <= z)
+    }
+}
+
+/// No segment.
+const NONE: u32 = u32::MAX;
+
+/// For each segment, the one that starts on the edge where it ends (`NONE` if there is
+/// none); when several start on one edge (a non-manifold edge), the first of them.
+fn successors(segments: &[Segment]) -> Vec<u32> {
+    let mut starting: FxHashMap<u64, u32> =
+        FxHashMap::with_capacity_and_hasher(segments.len(), Default::default());
+    for (i, s) in segments.iter().enumerate().rev() {
+        starting.insert(s.from, i as u32);
+    }
+    segments.iter().map(|s| starting.get(&s.to).copied().unwrap_or(NONE)).collect()
+}
+
 /// Chains one plane's segments into loops, closing open chains by pairing their loose ends.
-fn chain(segments: &mut [Segment], height: f64) -> Section {
-    segments.sort_unstable_by_key(|s| s.from);
-    let next_of = |key: u64, segs: &[Segment]| -> Option<usize> {
-        let i = segs.partition_point(|s| s.from < key);
-        (i < segs.len() && segs[i].from == key).then_some(i)
-    };
+fn chain(segments: &[Segment], height: f64) -> Section {
+    let next = successors(segments);
     let mut is_target = vec![false; segments.len()];
-    for s in segments.iter() {
-        if let Some(j) = next_of(s.to, segments) {
-            is_target[j] = true;
+    for &j in &next {
+        if j != NONE {
+            is_target[j as usize] = true;
         }
     }
     let mut used = vec![false; segments.len()];
@@ -136,9 +189,9 @@ fn chain(segments: &mut [Segment], height: f64) -> Section {
         loop {
             used[at] = true;
             points.push(segments[at].start);
-            match next_of(segments[at].to, segments) {
-                Some(j) if j == first => return (points, true),
-                Some(j) if !used[j] => at = j,
+            match next[at] {
+                j if j as usize == first => return (points, true),
+                j if j != NONE && !used[j as usize] => at = j as usize,
                 _ => {
                     points.push(segments[at].end); // an open chain keeps its last point
                     return (points, false);
@@ -162,10 +215,16 @@ fn chain(segments: &mut [Segment], height: f64) -> Section {
     }
     let bridged_gaps = open.len();
     closed.extend(close_open_chains(open));
-    let mut loops: Vec<Contour> =
-        closed.into_iter().filter(|p| p.len() >= 3).map(|points| Contour { points }).collect();
-    loops.sort_by(|a, b| b.signed_area().abs().total_cmp(&a.signed_area().abs()));
-    Section { height, loops, bridged_gaps }
+    let mut loops: Vec<(f64, Contour)> = closed
+        .into_iter()
+        .filter(|p| p.len() >= 3)
+        .map(|points| {
+            let c = Contour { points };
+            (c.signed_area().abs(), c)
+        })
+        .collect();
+    loops.sort_by(|a, b| b.0.total_cmp(&a.0));
+    Section { height, loops: loops.into_iter().map(|(_, c)| c).collect(), bridged_gaps }
 }
 
 /// Joins open chains into loops: the end of a chain is joined to the nearest chain start

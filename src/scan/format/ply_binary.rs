@@ -3,11 +3,17 @@
 //! elements of scalars only. ply-rs-bw parses the header; this decodes the payload without
 //! a call per property, which makes million-triangle scans load about ten times faster.
 //! Other layouts (lists in other elements, several lists per face) go through ply-rs-bw.
+//!
+//! Vertices have a fixed size, and so do faces when every face is a triangle (what scanners
+//! write): those are decoded in parallel, record by record. Faces of mixed sizes are read one
+//! after the other.
 
 use super::{ReadError, fan};
 use crate::mesh::Mesh;
 use glam::DVec3;
 use ply_rs_bw::ply::{ElementDef, Encoding, Header, PropertyType, ScalarType};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A PLY scalar type (ply-rs-bw's `ScalarType` is not `Copy`).
 #[derive(Debug, Clone, Copy)]
@@ -53,6 +59,50 @@ enum Property {
     List(Num, Num),
 }
 
+/// Reads the number of type `t` at the start of `bytes` (which holds at least its size) as
+/// f64, exact for every integer type.
+fn scalar(bytes: &[u8], t: Num, big_endian: bool) -> f64 {
+    match t {
+        Num::F32 => f32::from_bits(unsigned(bytes, 4, big_endian) as u32).into(),
+        Num::F64 => f64::from_bits(unsigned(bytes, 8, big_endian)),
+        _ => integer(bytes, t, big_endian).unwrap_or(0) as f64,
+    }
+}
+
+/// Reads the integer of type `t` at the start of `bytes` (a list count or a vertex index);
+/// `None` for a float type, which is a malformed index list.
+fn integer(bytes: &[u8], t: Num, big_endian: bool) -> Option<i64> {
+    let u = unsigned(bytes, t.size(), big_endian);
+    Some(match t {
+        Num::I8 => (u as u8 as i8).into(),
+        Num::I16 => (u as u16 as i16).into(),
+        Num::I32 => (u as u32 as i32).into(),
+        Num::U8 | Num::U16 | Num::U32 => u as i64,
+        Num::F32 | Num::F64 => return None,
+    })
+}
+
+/// The first `size` (1, 2, 4 or 8) bytes of `bytes` as an unsigned integer.
+fn unsigned(bytes: &[u8], size: usize, big_endian: bool) -> u64 {
+    fn read<const N: usize>(bytes: &[u8], big_endian: bool) -> [u8; N] {
+        let mut b = bytes.first_chunk::<N>().copied().unwrap_or([0; N]);
+        if big_endian {
+            b.reverse();
+        }
+        b
+    }
+    match size {
+        1 => bytes.first().copied().unwrap_or(0).into(),
+        2 => u16::from_le_bytes(read(bytes, big_endian)).into(),
+        4 => u32::from_le_bytes(read(bytes, big_endian)).into(),
+        _ => u64::from_le_bytes(read(bytes, big_endian)),
+    }
+}
+
+fn not_an_index() -> ReadError {
+    ReadError::Malformed("vertex indices must be integers".into())
+}
+
 /// A little reader over the payload that reports running out of bytes as truncation.
 struct Cursor<'a> {
     bytes: &'a [u8],
@@ -60,58 +110,25 @@ struct Cursor<'a> {
     big_endian: bool,
 }
 
-impl Cursor<'_> {
-    fn take<const N: usize>(&mut self) -> Result<[u8; N], ReadError> {
-        let end = self.at + N;
-        let chunk = self.bytes.get(self.at..end).ok_or_else(|| {
-            ReadError::Truncated(format!(
-                "the payload ends at byte {} of the data",
-                self.bytes.len()
-            ))
-        })?;
-        self.at = end;
-        let mut out = [0u8; N];
-        out.copy_from_slice(chunk);
-        if self.big_endian {
-            out.reverse();
-        }
-        Ok(out)
+impl<'a> Cursor<'a> {
+    /// The next `n` bytes.
+    fn take(&mut self, n: usize) -> Result<&'a [u8], ReadError> {
+        let bytes = self.bytes;
+        let chunk =
+            self.at.checked_add(n).and_then(|end| bytes.get(self.at..end)).ok_or_else(|| {
+                ReadError::Truncated(format!(
+                    "the payload ends at byte {} of the data",
+                    bytes.len()
+                ))
+            })?;
+        self.at += n;
+        Ok(chunk)
     }
 
-    /// Reads one scalar of type `t` as f64 (exact for every integer type).
-    fn number(&mut self, t: Num) -> Result<f64, ReadError> {
-        Ok(match t {
-            Num::F32 => f32::from_le_bytes(self.take()?).into(),
-            Num::F64 => f64::from_le_bytes(self.take()?),
-            _ => self.integer(t)? as f64,
-        })
-    }
-
-    /// Reads one integer of type `t` (a list count or a vertex index); a float type is a
-    /// malformed index list.
+    /// Reads one integer of type `t` (see [`integer`]).
     fn integer(&mut self, t: Num) -> Result<i64, ReadError> {
-        Ok(match t {
-            Num::I8 => i8::from_le_bytes(self.take()?).into(),
-            Num::U8 => u8::from_le_bytes(self.take()?).into(),
-            Num::I16 => i16::from_le_bytes(self.take()?).into(),
-            Num::U16 => u16::from_le_bytes(self.take()?).into(),
-            Num::I32 => i32::from_le_bytes(self.take()?).into(),
-            Num::U32 => u32::from_le_bytes(self.take()?).into(),
-            Num::F32 | Num::F64 => {
-                return Err(ReadError::Malformed("vertex indices must be integers".into()));
-            }
-        })
-    }
-
-    fn skip(&mut self, n: usize) -> Result<(), ReadError> {
-        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len()).ok_or_else(|| {
-            ReadError::Truncated(format!(
-                "the payload ends at byte {} of the data",
-                self.bytes.len()
-            ))
-        })?;
-        self.at = end;
-        Ok(())
+        let bytes = self.take(t.size())?;
+        integer(bytes, t, self.big_endian).ok_or_else(not_an_index)
     }
 }
 
@@ -167,6 +184,7 @@ pub(super) fn read(bytes: &[u8], header: &Header) -> Option<Result<Mesh, ReadErr
 }
 
 fn decode(cursor: &mut Cursor, header: &Header, layouts: &[Layout]) -> Result<Mesh, ReadError> {
+    let big_endian = cursor.big_endian;
     let mut positions: Vec<DVec3> = Vec::new();
     let mut triangles = Vec::new();
     for (element, layout) in header.elements.values().zip(layouts) {
@@ -186,58 +204,144 @@ fn decode(cursor: &mut Cursor, header: &Header, layouts: &[Layout]) -> Result<Me
                         cursor.bytes.len() - cursor.at
                     )));
                 }
-                positions.reserve(element.count);
-                for _ in 0..element.count {
-                    let start = cursor.at;
-                    let mut coordinate = |(t, offset): (Num, usize)| {
-                        cursor.at = start + offset;
-                        cursor.number(t)
-                    };
-                    let p = DVec3::new(coordinate(x)?, coordinate(y)?, coordinate(z)?);
-                    positions.push(p);
-                    cursor.at = start + stride;
-                }
+                let coordinate =
+                    |v: &[u8], (t, offset): (Num, usize)| scalar(&v[offset..], t, big_endian);
+                positions = cursor
+                    .take(need)?
+                    .par_chunks_exact(*stride)
+                    .map(|v| DVec3::new(coordinate(v, x), coordinate(v, y), coordinate(v, z)))
+                    .collect();
             }
             (_, Layout::Scalars(stride, _)) => {
-                cursor.skip(element.count.saturating_mul(*stride))?;
+                cursor.take(element.count.saturating_mul(*stride))?;
             }
             (_, Layout::Face(types, list)) => {
                 let vertices = positions.len();
-                let mut polygon = Vec::new();
-                triangles.reserve(element.count);
-                for face in 0..element.count {
-                    for (k, t) in types.iter().enumerate() {
-                        match *t {
-                            Property::Scalar(s) => cursor.skip(s.size())?,
-                            Property::List(count_type, index_type) => {
-                                let count = cursor.integer(count_type)?.max(0) as usize;
-                                polygon.clear();
-                                for _ in 0..count {
-                                    let index = cursor.integer(index_type)?;
-                                    if k != *list {
-                                        continue;
-                                    }
-                                    match u32::try_from(index) {
-                                        Ok(i) if (i as usize) < vertices => polygon.push(i),
-                                        _ => {
-                                            return Err(ReadError::IndexOutOfRange {
-                                                face,
-                                                index,
-                                                vertices,
-                                            });
-                                        }
-                                    }
-                                }
-                                match polygon[..] {
-                                    [a, b, c] => triangles.push([a, b, c]),
-                                    _ => fan(&polygon, &mut triangles),
-                                }
-                            }
+                triangles = match fixed_triangles(cursor, element.count, types, *list) {
+                    Some(records) => decode_triangles(records, types, *list, big_endian, vertices)?,
+                    None => read_polygons(cursor, element.count, types, *list, vertices)?,
+                };
+            }
+        }
+    }
+    Ok(Mesh::new(positions, triangles))
+}
+
+/// The face records, when every one of the `count` faces is a triangle (so all have one
+/// size); the cursor moves past them. `None` (cursor unmoved) otherwise. Exact: if the face
+/// at record `k` is a triangle, face `k + 1` starts at record `k + 1`.
+fn fixed_triangles<'a>(
+    cursor: &mut Cursor<'a>,
+    count: usize,
+    types: &[Property],
+    list: usize,
+) -> Option<&'a [u8]> {
+    let mut size = 0;
+    let mut count_at = 0;
+    for (k, t) in types.iter().enumerate() {
+        match *t {
+            Property::Scalar(s) => size += s.size(),
+            Property::List(count_type, index_type) => {
+                count_at = size;
+                size += count_type.size() + 3 * index_type.size();
+                if k != list || matches!(index_type, Num::F32 | Num::F64) {
+                    return None;
+                }
+            }
+        }
+    }
+    let Property::List(count_type, _) = types[list] else { return None };
+    let records = cursor.bytes.get(cursor.at..cursor.at.checked_add(count.checked_mul(size)?)?)?;
+    let triangle = |r: &[u8]| integer(&r[count_at..], count_type, cursor.big_endian) == Some(3);
+    if !records.par_chunks_exact(size).all(triangle) {
+        return None;
+    }
+    cursor.at += records.len();
+    Some(records)
+}
+
+/// Decodes fixed-size triangle records (see [`fixed_triangles`]) in parallel, checking that
+/// every index names one of the `vertices`.
+fn decode_triangles(
+    records: &[u8],
+    types: &[Property],
+    list: usize,
+    big_endian: bool,
+    vertices: usize,
+) -> Result<Vec<[u32; 3]>, ReadError> {
+    let size_of = |t: &Property| match *t {
+        Property::Scalar(s) => s.size(),
+        Property::List(c, i) => c.size() + 3 * i.size(),
+    };
+    let stride: usize = types.iter().map(size_of).sum();
+    let Property::List(count_type, index_type) = types[list] else {
+        return Err(not_an_index());
+    };
+    let first = types[..list].iter().map(size_of).sum::<usize>() + count_type.size();
+    let raw = |r: &[u8], k: usize| {
+        integer(&r[first + k * index_type.size()..], index_type, big_endian).unwrap_or(-1)
+    };
+    let in_range = |i: i64| usize::try_from(i).is_ok_and(|i| i < vertices);
+    // One pass decodes and checks; a bad index is only located (for the message) afterwards.
+    let bad = AtomicBool::new(false);
+    let index = |r: &[u8], k: usize| {
+        let i = raw(r, k);
+        if in_range(i) {
+            i as u32
+        } else {
+            bad.store(true, Ordering::Relaxed);
+            u32::MAX
+        }
+    };
+    let triangles: Vec<[u32; 3]> =
+        records.par_chunks_exact(stride).map(|r| [index(r, 0), index(r, 1), index(r, 2)]).collect();
+    if bad.load(Ordering::Relaxed) {
+        for (face, r) in records.chunks_exact(stride).enumerate() {
+            if let Some(index) = (0..3).map(|k| raw(r, k)).find(|&i| !in_range(i)) {
+                return Err(ReadError::IndexOutOfRange { face, index, vertices });
+            }
+        }
+    }
+    Ok(triangles)
+}
+
+/// Reads `count` faces of any sizes one after the other, fanning polygons into triangles and
+/// checking that every index names one of the `vertices`.
+fn read_polygons(
+    cursor: &mut Cursor,
+    count: usize,
+    types: &[Property],
+    list: usize,
+    vertices: usize,
+) -> Result<Vec<[u32; 3]>, ReadError> {
+    let mut triangles = Vec::with_capacity(count);
+    let mut polygon = Vec::new();
+    for face in 0..count {
+        for (k, t) in types.iter().enumerate() {
+            match *t {
+                Property::Scalar(s) => {
+                    cursor.take(s.size())?;
+                }
+                Property::List(count_type, index_type) => {
+                    let n = cursor.integer(count_type)?.max(0) as usize;
+                    polygon.clear();
+                    for _ in 0..n {
+                        let index = cursor.integer(index_type)?;
+                        if k != list {
+                            continue;
                         }
+                        match u32::try_from(index) {
+                            Ok(i) if (i as usize) < vertices => polygon.push(i),
+                            _ => return Err(ReadError::IndexOutOfRange { face, index, vertices }),
+                        }
+                    }
+                    match polygon[..] {
+                        [a, b, c] => triangles.push([a, b, c]),
+                        _ => fan(&polygon, &mut triangles),
                     }
                 }
             }
         }
     }
-    Ok(Mesh::new(positions, triangles))
+    Ok(triangles)
 }
