@@ -180,3 +180,36 @@ fn bad_flags_are_usage_errors() {
     assert_eq!(code, 2);
     assert!(stderr.contains("not an axis"), "{stderr}");
 }
+
+/// Standard output that fails: a reader that closed the pipe ends the output quietly; a full
+/// device is an error (status 1), never a panic.
+#[test]
+fn failing_standard_output() {
+    use std::process::{Command, Stdio};
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(dir.path(), "ok.obj", octahedron_obj(""));
+    // Thousands of planes: far more text than a pipe buffers, so writes meet the closed pipe.
+    let heights: Vec<String> = (0..6000).map(|i| format!("{:.1}", i as f64 * 0.3)).collect();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_dressform"))
+        .args(["slice", path.to_str().unwrap(), "--heights", &heights.join(",")])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take()); // the reader goes away (like `| head`)
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_dressform"))
+        .args(["info", path.to_str().unwrap()])
+        .stdout(full)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("cannot write the output"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}

@@ -51,7 +51,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
     bar.finish_and_clear();
 
     let truth = &customer.truth;
-    println!(
+    outln!(
         "A synthetic customer: {:.0} mm tall, chest {:.0}, waist {:.0}, hip {:.0} mm, crotch height {:.0} mm.",
         truth.height_mm,
         truth.chest.tape_girth_mm,
@@ -59,26 +59,30 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         truth.hip.tape_girth_mm,
         truth.crotch_height_mm
     );
-    println!(
+    outln!(
         "Scanned with {:.1} mm noise, holes at the armpits, crotch and soles, in metres, Y up, turned {:.0} degrees:",
-        artifacts.noise_sigma_mm, artifacts.yaw_deg
+        artifacts.noise_sigma_mm,
+        artifacts.yaw_deg
     );
-    print!("{info}");
-    println!();
+    out!("{info}");
+    outln!();
     let result =
         shape_form(&scan, &sim::form::reference(), &LinkSpec::Sim, &SimArgs::default(), &args.out)?;
-    println!();
-    println!("  {:<12} {:>9} {:>9} {:>11}", "measure (mm)", "customer", "scan", "mannequin");
+    outln!();
+    outln!("  {:<12} {:>9} {:>9} {:>11}", "measure (mm)", "customer", "scan", "mannequin");
     let c = &result.comparison;
-    println!("  {:<12} {:>9.1} {:>9.1} {:>11}", "height", truth.height_mm, c.input.height, "-");
+    outln!("  {:<12} {:>9.1} {:>9.1} {:>11}", "height", truth.height_mm, c.input.height, "-");
     for (row, asked) in c.table.iter().zip([truth.chest, truth.waist, truth.hip]) {
-        println!(
+        outln!(
             "  {:<12} {:>9.1} {:>9.1} {:>11.1}",
-            row.measure, asked.tape_girth_mm, row.input.tape, row.mannequin.tape
+            row.measure,
+            asked.tape_girth_mm,
+            row.input.tape,
+            row.mannequin.tape
         );
     }
-    println!();
-    println!(
+    outln!();
+    outln!(
         "Written to {}: scan.ply, mannequin.obj, profiles.json, measurements.json, setpoints.json",
         args.out.display()
     );

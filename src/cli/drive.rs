@@ -201,7 +201,7 @@ fn print_report(report: &DriveReport, json: bool) -> Result<(), Failure> {
     }
     if json {
         let text = serde_json::to_string_pretty(report).map_err(Failure::other)?;
-        println!("{text}");
+        outln!("{text}");
     } else {
         print_table(report);
     }
@@ -209,7 +209,7 @@ fn print_report(report: &DriveReport, json: bool) -> Result<(), Failure> {
 }
 
 fn print_table(report: &DriveReport) {
-    println!(
+    outln!(
         "{} on {}: {} actuators, SYNC {} ms, done after {} ms",
         report.form,
         report.device,
@@ -217,13 +217,17 @@ fn print_table(report: &DriveReport) {
         report.duration_ms,
         report.elapsed_ms
     );
-    println!(
+    outln!(
         "{:<18} {:>4} {:>9} {:>9} {:>8}  status",
-        "actuator", "node", "target", "reached", "error"
+        "actuator",
+        "node",
+        "target",
+        "reached",
+        "error"
     );
     let mm = |v: Option<f64>| v.map_or_else(|| "-".to_string(), |v| format!("{v:.2}"));
     for a in &report.actuators {
-        println!(
+        outln!(
             "{:<18} {:>4} {:>9.2} {:>9} {:>8}  {}",
             a.id,
             a.node,

@@ -23,9 +23,9 @@ pub fn run(args: &InfoArgs) -> Result<(), Failure> {
         warn(&info.file, w);
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&info).map_err(Failure::other)?);
+        outln!("{}", serde_json::to_string_pretty(&info).map_err(Failure::other)?);
     } else {
-        print!("{info}");
+        out!("{info}");
     }
     Ok(())
 }

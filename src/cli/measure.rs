@@ -52,25 +52,27 @@ pub fn run(args: &MeasureArgs) -> Result<(), Failure> {
         .collect();
     let out = MeasureOut { file, landmarks: regions.landmarks, levels, measurements, at };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&out).map_err(Failure::other)?);
+        outln!("{}", serde_json::to_string_pretty(&out).map_err(Failure::other)?);
         return Ok(());
     }
     let m = &out.measurements;
-    println!("{}", out.file);
-    println!("  height          {:7.1} mm", m.height);
-    println!("  crotch height   {:7.1} mm", m.crotch_height);
+    outln!("{}", out.file);
+    outln!("  height          {:7.1} mm", m.height);
+    outln!("  crotch height   {:7.1} mm", m.crotch_height);
     for (name, g) in [("chest", m.chest), ("waist", m.waist), ("hip", m.hip)] {
-        println!(
+        outln!(
             "  {name:<6} girth    {:7.1} mm at z = {:.0} mm (contour {:.1} mm)",
-            g.tape, g.z, g.contour
+            g.tape,
+            g.z,
+            g.contour
         );
     }
     for (z, g) in args.at.iter().zip(&out.at) {
         match g {
             Some(g) => {
-                println!("  torso at {z:.0} mm  {:7.1} mm (contour {:.1} mm)", g.tape, g.contour)
+                outln!("  torso at {z:.0} mm  {:7.1} mm (contour {:.1} mm)", g.tape, g.contour)
             }
-            None => println!("  torso at {z:.0} mm  none"),
+            None => outln!("  torso at {z:.0} mm  none"),
         }
     }
     Ok(())

@@ -1,5 +1,23 @@
 //! Command-line arguments and dispatch. Each command lives in its own module.
 
+/// `print!` for a command's output, through [`write_out`]: it never panics when standard
+/// output fails.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::cli::write_out(format_args!($($arg)*))
+    };
+}
+
+/// `println!` for a command's output (see [`out!`]).
+macro_rules! outln {
+    () => {
+        $crate::cli::write_out(format_args!("\n"))
+    };
+    ($($arg:tt)*) => {
+        $crate::cli::write_out(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
 mod demo;
 mod drive;
 mod estop;
@@ -14,6 +32,8 @@ mod symmetrize;
 
 use clap::{Parser, Subcommand};
 use dressform::scan::frame::{Direction, FrameOptions, Units};
+use std::io::{ErrorKind, Write};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Personalized symmetric mannequins from 3D body scans, and the robotic dress form they drive.
 #[derive(Debug, Parser)]
@@ -112,6 +132,26 @@ pub fn run(args: Args) -> Result<(), Failure> {
         Command::Status(a) => status::run(&a),
         Command::Estop(a) => estop::run(&a),
     }
+}
+
+/// Set once writing to standard output failed (other than by a closed pipe).
+static OUTPUT_FAILED: AtomicBool = AtomicBool::new(false);
+
+/// Writes command output. A reader that closed the pipe (`dressform slice ... | head`)
+/// just ends the output; any other failure (a full disk) is reported once and fails the
+/// command (see [`output_failed`]), without stopping what it is doing (a form mid-move).
+pub fn write_out(text: std::fmt::Arguments) {
+    if let Err(e) = std::io::stdout().lock().write_fmt(text)
+        && e.kind() != ErrorKind::BrokenPipe
+        && !OUTPUT_FAILED.swap(true, Ordering::Relaxed)
+    {
+        eprintln!("error: cannot write the output: {e}");
+    }
+}
+
+/// Whether some output could not be written.
+pub fn output_failed() -> bool {
+    OUTPUT_FAILED.load(Ordering::Relaxed)
 }
 
 /// Prints a warning about `file` on standard error.

@@ -74,12 +74,12 @@ pub fn shape_form(
     write_outputs(out, &result, &profiles, &setpoints)?;
     bar.finish_and_clear();
 
-    println!("Symmetric mannequin and set-points written to {}.", out.display());
-    println!("Fit of form \"{}\" (ring heights on the form and on the body):", form.name);
-    print!("{}", fidelity_table(&fitted));
-    println!();
+    outln!("Symmetric mannequin and set-points written to {}.", out.display());
+    outln!("Fit of form \"{}\" (ring heights on the form and on the body):", form.name);
+    out!("{}", fidelity_table(&fitted));
+    outln!();
     let report = execute(form, &setpoints, link, &DriveOptions::default(), sim, false)?;
-    println!(
+    outln!(
         "{} on {}: {} actuators moved together in {} ms; {}.",
         report.form,
         report.device,
@@ -91,8 +91,8 @@ pub fn shape_form(
             "some actuators did NOT arrive"
         }
     );
-    println!();
-    print!("{}", girth_table(scan, &result, form, &fitted, &report));
+    outln!();
+    out!("{}", girth_table(scan, &result, form, &fitted, &report));
     Ok(result)
 }
 

@@ -50,10 +50,10 @@ pub fn run(args: &SetpointsArgs) -> Result<(), Failure> {
         .save(&args.out)
         .map_err(Failure::other)?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&fitted).map_err(Failure::other)?);
+        outln!("{}", serde_json::to_string_pretty(&fitted).map_err(Failure::other)?);
     } else {
-        print!("{}", fidelity_table(&fitted));
-        println!("set-points written to {}", args.out.display());
+        out!("{}", fidelity_table(&fitted));
+        outln!("set-points written to {}", args.out.display());
     }
     Ok(())
 }

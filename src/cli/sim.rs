@@ -41,7 +41,7 @@ pub fn run(args: &SimArgs) -> Result<(), Failure> {
     config.log = args.log.clone();
     config.faults = faults;
     run_until_ctrl_c(config, |device| {
-        println!("{}", device.display());
+        outln!("{}", device.display());
         let _ = std::io::stdout().flush();
         eprintln!("simulated form ready on {} (Ctrl-C to stop)", device.display());
     })

@@ -102,17 +102,20 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
         );
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&out).map_err(Failure::other)?);
+        outln!("{}", serde_json::to_string_pretty(&out).map_err(Failure::other)?);
         return Ok(());
     }
-    println!("{file}");
+    outln!("{file}");
     for s in &out.sections {
-        println!("  z = {:.1} mm: {} loops", s.z_mm, s.loops.len());
+        outln!("  z = {:.1} mm: {} loops", s.z_mm, s.loops.len());
         for l in &s.loops {
             let label = l.label.map_or("unlabelled".to_string(), |r| format!("{r:?}"));
-            println!(
+            outln!(
                 "    {label:<10} contour {:8.1} mm  tape girth {:8.1} mm  at ({:.0}, {:.0})",
-                l.perimeter_mm, l.tape_girth_mm, l.centroid_mm[0], l.centroid_mm[1]
+                l.perimeter_mm,
+                l.tape_girth_mm,
+                l.centroid_mm[0],
+                l.centroid_mm[1]
             );
         }
     }

@@ -46,7 +46,7 @@ pub fn run(args: &StatusArgs) -> Result<(), Failure> {
         }
     })?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&reports).map_err(Failure::other)?);
+        outln!("{}", serde_json::to_string_pretty(&reports).map_err(Failure::other)?);
     } else {
         print(&reports);
     }
@@ -65,13 +65,13 @@ fn print(reports: &[NodeReport]) {
         } else {
             format!(", faults {}", r.faults.join("|"))
         };
-        println!("node {}: {state} ({version}){faults}", r.node);
+        outln!("node {}: {state} ({version}){faults}", r.node);
         for problem in &r.problems {
-            println!("  problem: {problem}");
+            outln!("  problem: {problem}");
         }
         for (id, mm) in &r.positions_mm {
             let p = mm.map_or_else(|| "unknown".to_string(), |v| format!("{v:.2} mm"));
-            println!("  {id:<18} {p}");
+            outln!("  {id:<18} {p}");
         }
     }
 }

@@ -86,7 +86,7 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     }
     bar.finish_and_clear();
     if args.json {
-        println!("{measurements}");
+        outln!("{measurements}");
     } else {
         print_table(&file, &result.comparison, &args.out);
     }
@@ -98,26 +98,32 @@ fn pretty_json(value: &impl serde::Serialize) -> Result<String, Failure> {
 }
 
 fn print_table(file: &str, c: &Comparison, out: &std::path::Path) {
-    println!("{file}: symmetric mannequin written to {}", out.display());
-    println!(
-        "  {:<6} {:>8} {:>12} {:>12} {:>9}",
-        "", "z (mm)", "input (mm)", "mannequin", "change"
-    );
+    outln!("{file}: symmetric mannequin written to {}", out.display());
+    outln!("  {:<6} {:>8} {:>12} {:>12} {:>9}", "", "z (mm)", "input (mm)", "mannequin", "change");
     for row in &c.table {
-        println!(
+        outln!(
             "  {:<6} {:>8.0} {:>12.1} {:>12.1} {:>+9.2}",
-            row.measure, row.z, row.input.tape, row.mannequin.tape, row.tape_change_mm
+            row.measure,
+            row.z,
+            row.input.tape,
+            row.mannequin.tape,
+            row.tape_change_mm
         );
     }
-    println!(
+    outln!(
         "  (tape girths; height {:.0} mm, crotch height {:.0} mm)",
-        c.input.height, c.input.crotch_height
+        c.input.height,
+        c.input.crotch_height
     );
-    println!("  {:<15} {:>10} {:>8} {:>8} {:>8}", "Fig. 11", "hip width", "chest", "waist", "hip");
+    outln!("  {:<15} {:>10} {:>8} {:>8} {:>8}", "Fig. 11", "hip width", "chest", "waist", "hip");
     for r in &c.mirrored {
-        println!(
+        outln!(
             "  {:<15} {:>10.1} {:>8.1} {:>8.1} {:>8.1}",
-            r.body, r.hip_width, r.chest, r.waist, r.hip
+            r.body,
+            r.hip_width,
+            r.chest,
+            r.waist,
+            r.hip
         );
     }
 }
