@@ -11,7 +11,7 @@ fn main() -> ExitCode {
         Ok(()) if cli::output_failed() => ExitCode::FAILURE,
         Ok(()) => ExitCode::SUCCESS,
         Err(failure) => {
-            eprintln!("error: {}", failure.message);
+            cli::write_err(format_args!("error: {}\n", failure.message));
             ExitCode::from(failure.exit_code)
         }
     }

@@ -179,37 +179,67 @@ fn bad_flags_are_usage_errors() {
     let (code, _, stderr) = dressform(&["info", "x.obj", "--up", "sideways"]);
     assert_eq!(code, 2);
     assert!(stderr.contains("not an axis"), "{stderr}");
+    for (command, flag) in [("slice", "--heights"), ("measure", "--at")] {
+        let (code, _, stderr) = dressform(&[command, "x.obj", flag, "900,NaN"]);
+        assert_eq!(code, 2, "{stderr}");
+        assert!(stderr.contains(&format!("{flag}: NaN is not a height")), "{stderr}");
+    }
 }
 
-/// Standard output that fails: a reader that closed the pipe ends the output quietly; a full
-/// device is an error (status 1), never a panic.
+/// Output streams that fail: a reader that closed the pipe ends the output quietly; a full
+/// device for the output is an error (status 1); a failing standard error loses the messages.
+/// Never a panic (status 101).
 #[test]
-fn failing_standard_output() {
+fn failing_output_streams() {
     use std::process::{Command, Stdio};
     let dir = tempfile::tempdir().unwrap();
     let path = write(dir.path(), "ok.obj", octahedron_obj(""));
-    // Thousands of planes: far more text than a pipe buffers, so writes meet the closed pipe.
-    let heights: Vec<String> = (0..6000).map(|i| format!("{:.1}", i as f64 * 0.3)).collect();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_dressform"))
-        .args(["slice", path.to_str().unwrap(), "--heights", &heights.join(",")])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    drop(child.stdout.take()); // the reader goes away (like `| head`)
-    let out = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
+    let warned = write(dir.path(), "degenerate.obj", octahedron_obj("f 1 1 2\n"));
+    let full = || std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let closed_pipe = || {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        writer
+    };
+    let run = |args: &[&str], stdout: Stdio, stderr: Stdio| {
+        let out = Command::new(env!("CARGO_BIN_EXE_dressform"))
+            .args(args)
+            .stdout(stdout)
+            .stderr(stderr)
+            .output()
+            .unwrap();
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let info = ["info", path.to_str().unwrap()];
+    let (code, stderr) = run(&info, closed_pipe().into(), Stdio::piped());
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stderr.is_empty(), "{stderr}");
 
-    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_dressform"))
-        .args(["info", path.to_str().unwrap()])
-        .stdout(full)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let (code, stderr) = run(&info, full().into(), Stdio::piped());
+    assert_eq!(code, Some(1), "{stderr}");
     assert!(stderr.contains("cannot write the output"), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
+
+    // Warnings and errors on a standard error that cannot take them.
+    let warn = ["info", warned.to_str().unwrap()];
+    assert_eq!(run(&warn, Stdio::null(), closed_pipe().into()).0, Some(0));
+    assert_eq!(run(&warn, Stdio::null(), full().into()).0, Some(0));
+    assert_eq!(run(&info, full().into(), full().into()).0, Some(1));
+    let missing = ["info", "no-such-scan.ply"];
+    assert_eq!(run(&missing, Stdio::null(), closed_pipe().into()).0, Some(2));
+}
+
+#[test]
+fn face_counts_beyond_the_file_are_truncation() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n\
+                    property float y\nproperty float z\nelement face 4611686018427387904\n\
+                    property list uchar int vertex_indices\nend_header\n"
+        .to_vec();
+    for p in [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.7, 0.0]] {
+        p.iter().for_each(|c| ply.extend(c.to_le_bytes()));
+    }
+    ply.push(4); // a quad, so the faces are read one by one
+    [0i32, 1, 2, 0].iter().for_each(|i| ply.extend(i.to_le_bytes()));
+    assert_rejected(&write(dir.path(), "count.ply", ply), "truncated");
 }

@@ -194,10 +194,10 @@ impl From<DriveError> for Failure {
 
 fn print_report(report: &DriveReport, json: bool) -> Result<(), Failure> {
     for (id, asked, used) in &report.clamped {
-        eprintln!("warning: {id}: {asked} mm is outside the stroke, clamped to {used} mm");
+        errln!("warning: {id}: {asked} mm is outside the stroke, clamped to {used} mm");
     }
     for warning in &report.warnings {
-        eprintln!("warning: {warning}");
+        errln!("warning: {warning}");
     }
     if json {
         let text = serde_json::to_string_pretty(report).map_err(Failure::other)?;

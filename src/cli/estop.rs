@@ -32,6 +32,6 @@ pub fn run(args: &EstopArgs) -> Result<(), Failure> {
         let connection = Connection::open(&spec).map_err(Failure::other)?;
         emergency_stop(connection).await.map_err(Failure::other)
     })?;
-    eprintln!("emergency stop sent");
+    errln!("emergency stop sent");
     Ok(())
 }

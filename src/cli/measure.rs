@@ -34,6 +34,9 @@ struct MeasureOut {
 }
 
 pub fn run(args: &MeasureArgs) -> Result<(), Failure> {
+    if let Some(h) = args.at.iter().find(|h| !h.is_finite()) {
+        return Err(Failure::bad_input(format!("--at: {h} is not a height")));
+    }
     let mut scan = scan::load(&args.mesh, &args.frame.options()).map_err(Failure::bad_input)?;
     scan.body.taubin_smooth(args.smooth.smooth);
     let file = scan.source.display().to_string();

@@ -18,6 +18,13 @@ macro_rules! outln {
     };
 }
 
+/// `eprintln!` through [`write_err`]: it never panics when standard error fails.
+macro_rules! errln {
+    ($($arg:tt)*) => {
+        $crate::cli::write_err(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
 mod demo;
 mod drive;
 mod estop;
@@ -145,8 +152,14 @@ pub fn write_out(text: std::fmt::Arguments) {
         && e.kind() != ErrorKind::BrokenPipe
         && !OUTPUT_FAILED.swap(true, Ordering::Relaxed)
     {
-        eprintln!("error: cannot write the output: {e}");
+        errln!("error: cannot write the output: {e}");
     }
+}
+
+/// Writes a message on standard error; one that standard error cannot take (closed, full) is
+/// lost rather than a reason to stop.
+pub fn write_err(text: std::fmt::Arguments) {
+    let _ = std::io::stderr().lock().write_fmt(text);
 }
 
 /// Whether some output could not be written.
@@ -156,7 +169,7 @@ pub fn output_failed() -> bool {
 
 /// Prints a warning about `file` on standard error.
 fn warn(file: &str, message: &str) {
-    eprintln!("warning: {file}: {message}");
+    errln!("warning: {file}: {message}");
 }
 
 /// A progress bar on standard error for `steps` steps; hidden in `--json` mode and when

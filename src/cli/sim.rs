@@ -43,7 +43,7 @@ pub fn run(args: &SimArgs) -> Result<(), Failure> {
     run_until_ctrl_c(config, |device| {
         outln!("{}", device.display());
         let _ = std::io::stdout().flush();
-        eprintln!("simulated form ready on {} (Ctrl-C to stop)", device.display());
+        errln!("simulated form ready on {} (Ctrl-C to stop)", device.display());
     })
     .map_err(|e| match e {
         ServeError::Sim(_) => Failure::bad_input(e),

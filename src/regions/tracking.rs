@@ -128,18 +128,17 @@ pub(super) fn track(
 
     // Neck: the narrowest torso level between the armpits and the head's widest level.
     let armpit_z = left_armpit.max(right_armpit);
-    let above_armpits: Vec<(usize, f64)> = up
+    let head_level = floor + 0.87 * height;
+    let girths: Vec<(usize, f64)> = up
         .par_iter()
-        .filter(|&&(i, _)| z_of(i) > armpit_z)
+        .filter(|&&(i, _)| z_of(i) > armpit_z || z_of(i) >= head_level)
         .map(|&(i, k)| (i, sections[i].loops[k].tape_girth()))
         .collect();
-    let head_widest = above_armpits
+    let head_widest =
+        girths.iter().filter(|&&(i, _)| z_of(i) >= head_level).max_by(|a, b| a.1.total_cmp(&b.1));
+    let neck = girths
         .iter()
-        .filter(|&&(i, _)| z_of(i) >= floor + 0.87 * height)
-        .max_by(|a, b| a.1.total_cmp(&b.1));
-    let neck = above_armpits
-        .iter()
-        .filter(|&&(i, _)| head_widest.is_none_or(|h| i < h.0))
+        .filter(|&&(i, _)| z_of(i) > armpit_z && head_widest.is_none_or(|h| i < h.0))
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map_or(armpit_z + 0.5 * (floor + height - armpit_z), |&(i, _)| z_of(i));
 

@@ -3,7 +3,8 @@
 //!
 //! - non-finite coordinates: error (the file is corrupt);
 //! - bit-identical vertices: welded (STL repeats corners; OBJ groups split shared vertices);
-//! - degenerate triangles (repeated corner, zero area): dropped;
+//! - degenerate triangles (a repeated corner, or flat: no area up to rounding, measured
+//!   against the triangle's own size, so no other vertex can change the verdict): dropped;
 //! - several connected components: the largest by area is the body; floor patches, props and
 //!   noise islands are dropped and listed; so are vertices no triangle uses (silently);
 //!
@@ -11,6 +12,7 @@
 //! [`crate::mesh::topology`] and [`Topology::warnings`].
 
 use crate::mesh::{Aabb, Mesh, components};
+use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -93,10 +95,9 @@ pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
     }
     let welded_vertices = mesh.weld_identical();
 
-    let scale = mesh.bounds().map_or(0.0, |b| b.size().length_squared());
     let degenerate = |t: usize| {
         let [a, b, c] = mesh.triangles[t];
-        a == b || b == c || a == c || mesh.triangle_area(t) <= scale * 1e-16
+        a == b || b == c || a == c || is_flat(mesh.corners(t))
     };
     let dropped: Vec<usize> =
         (0..mesh.triangles.len()).into_par_iter().filter(|&t| degenerate(t)).collect();
@@ -133,10 +134,17 @@ pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
     Ok((mesh, report))
 }
 
+/// Whether a triangle is flat: its area is within rounding of zero for its size (twice the
+/// area at most 1e-12 of its longest edge squared).
+fn is_flat([a, b, c]: [DVec3; 3]) -> bool {
+    let longest =
+        (b - a).length_squared().max((c - b).length_squared()).max((a - c).length_squared());
+    (b - a).cross(c - a).length() <= 1e-12 * longest
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::DVec3;
 
     /// An outward tetrahedron scaled by `s` at `at`, as its own vertices and triangles.
     fn tetrahedron(mesh: &mut Mesh, at: DVec3, s: f64) {
@@ -162,6 +170,23 @@ mod tests {
         assert_eq!(report.dropped_components.len(), 1);
         assert_eq!(report.dropped_components[0].triangles, 4);
         assert!((report.dropped_components[0].area_fraction - 1.0 / 101.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn flat_triangles_are_degenerate_whatever_else_is_in_the_scan() {
+        let mut mesh = Mesh::default();
+        tetrahedron(&mut mesh, DVec3::ZERO, 100.0);
+        // Collinear corners; a far vertex no triangle uses does not change anything.
+        mesh.positions.extend([DVec3::new(0.0, 0.0, 300.0), DVec3::new(0.0, 0.0, 200.0)]);
+        mesh.triangles.push([3, 4, 5]);
+        mesh.positions.push(DVec3::splat(1e10));
+        let (body, report) = clean(mesh).expect("cleans");
+        assert_eq!(report.degenerate_triangles, 1);
+        assert_eq!(body.triangles.len(), 4);
+        assert_eq!(body.positions.len(), 4);
+        // A tiny but well-shaped triangle is not flat.
+        assert!(!is_flat([DVec3::ZERO, DVec3::X * 1e-9, DVec3::Y * 1e-9]));
+        assert!(is_flat([DVec3::ZERO, DVec3::X, DVec3::X * 2.0]));
     }
 
     #[test]

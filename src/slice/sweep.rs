@@ -56,9 +56,10 @@ fn segment(mesh: &Mesh, tri: [u32; 3], h: f64) -> Segment {
     }
 }
 
-/// Cross-sections of `mesh` at each of `heights` (any order; returned in the same order).
+/// Cross-sections of `mesh` at each of `heights` (any order; returned in the same order). A
+/// height that is not a finite number crosses nothing: its section is empty.
 pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
-    let mut order: Vec<usize> = (0..heights.len()).collect();
+    let mut order: Vec<usize> = (0..heights.len()).filter(|&i| heights[i].is_finite()).collect();
     order.sort_by(|&a, &b| heights[a].total_cmp(&heights[b]));
     let planes = Planes::new(order.iter().map(|&i| heights[i]).collect());
 
@@ -108,19 +109,24 @@ pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
             chain(&segments, h)
         })
         .collect();
-    let mut out: Vec<Option<Section>> = vec![None; heights.len()];
+    let mut out: Vec<Section> = heights
+        .iter()
+        .map(|&height| Section { height, loops: Vec::new(), bridged_gaps: 0 })
+        .collect();
     for (section, &i) in by_plane.into_iter().zip(&order) {
-        out[i] = Some(section);
+        out[i] = section;
     }
-    out.into_iter().flatten().collect()
+    out
 }
 
-/// Sorted plane heights, bucketed so that counting the planes at or below a height takes a
-/// table lookup and a search among one or two buckets' planes instead of all of them.
+/// Sorted, finite plane heights, bucketed so that counting the planes at or below a height
+/// takes a table lookup and a search among one or two buckets' planes instead of all of them.
 struct Planes {
     sorted: Vec<f64>,
     lowest: f64,
-    /// Buckets per unit of height.
+    /// Buckets per unit of height; 0 when the planes span no range a bucket can divide (one
+    /// plane, all at one height, or a span too wide or too narrow for f64), and then the
+    /// search runs over all planes.
     scale: f64,
     /// `first[b]`: the planes at or below the lower edge of bucket `b`.
     first: Vec<usize>,
@@ -133,28 +139,33 @@ impl Planes {
             _ => (0.0, 0.0),
         };
         let buckets = 4 * sorted.len().min(1 << 14);
-        let scale = if highest > lowest { buckets as f64 / (highest - lowest) } else { 0.0 };
+        let scale = buckets as f64 / (highest - lowest);
+        let scale = if highest > lowest && scale.is_finite() { scale } else { 0.0 };
         let first = (0..=buckets)
             .map(|b| sorted.partition_point(|&h| (h - lowest) * scale <= b as f64))
             .collect();
         Planes { sorted, lowest, scale, first }
     }
 
-    /// How many planes lie at or below `z`.
+    /// How many planes lie at or below `z` (none below a NaN).
     fn at_or_below(&self, z: f64) -> usize {
         let n = self.sorted.len();
-        // (A NaN height lies below every plane.)
         if n == 0 || z.is_nan() || z < self.lowest {
             return 0;
         }
         if z >= self.sorted[n - 1] {
             return n;
         }
+        if self.scale == 0.0 {
+            return self.sorted.partition_point(|&h| h <= z);
+        }
         // The bucket of `z`, widened by one on each side against rounding.
         let b = ((z - self.lowest) * self.scale) as usize;
         let buckets = self.first.len() - 1;
-        let (from, to) =
-            (self.first[b.saturating_sub(1).min(buckets)], self.first[(b + 2).min(buckets)]);
+        let (from, to) = (
+            self.first[b.saturating_sub(1).min(buckets)],
+            self.first[b.saturating_add(2).min(buckets)],
+        );
         from + self.sorted[from..to].partition_point(|&h| h <= z)
     }
 }
@@ -305,6 +316,24 @@ mod tests {
             assert!(s.loops.iter().all(|l| l.points.len() >= 3));
             assert_eq!(s.bridged_gaps, 0);
         }
+    }
+
+    #[test]
+    fn heights_that_are_no_numbers_or_far_apart_leave_the_others_exact() {
+        let mesh = prism(64, 50.0);
+        let heights = [2.5, f64::NAN, 7.5, f64::INFINITY, f64::NEG_INFINITY, 1e308, -1e308, 5.0];
+        let s = sections(&mesh, &heights);
+        assert_eq!(s.len(), heights.len());
+        for (k, sec) in s.iter().enumerate() {
+            let inside = (0.0..=10.0).contains(&heights[k]);
+            assert_eq!(sec.loops.len(), usize::from(inside), "height {}", heights[k]);
+            if inside {
+                assert_eq!(sec.loops[0].points.len(), 128, "height {}", heights[k]);
+            }
+        }
+        // A span too narrow to divide into buckets (subnormal numbers).
+        let s = sections(&mesh, &[5e-310, 6e-310, 7e-310]);
+        assert!(s.iter().all(|sec| sec.loops.len() == 1 && sec.loops[0].points.len() == 128));
     }
 
     #[test]

@@ -314,7 +314,8 @@ fn read_polygons(
     list: usize,
     vertices: usize,
 ) -> Result<Vec<[u32; 3]>, ReadError> {
-    let mut triangles = Vec::with_capacity(count);
+    // Each face takes at least a byte: a header claiming more faces than bytes is cut short.
+    let mut triangles = Vec::with_capacity(count.min(cursor.bytes.len() - cursor.at));
     let mut polygon = Vec::new();
     for face in 0..count {
         for (k, t) in types.iter().enumerate() {
