@@ -193,15 +193,8 @@ impl DisjointSets {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::shapes::add_tetrahedron;
     use proptest::prelude::*;
-
-    /// A tetrahedron of edge scale `s` with its corner at `at`, appended to `mesh`.
-    fn add_tetrahedron(mesh: &mut Mesh, at: DVec3, s: f64) {
-        let first = mesh.positions.len() as u32;
-        mesh.positions.extend([at, at + DVec3::X * s, at + DVec3::Y * s, at + DVec3::Z * s]);
-        let [a, b, c, d] = [first, first + 1, first + 2, first + 3];
-        mesh.triangles.extend([[a, c, b], [a, b, d], [a, d, c], [b, c, d]]);
-    }
 
     #[test]
     fn pieces_come_largest_first_and_unused_vertices_belong_to_none() {

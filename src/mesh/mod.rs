@@ -184,3 +184,18 @@ impl Mesh {
         weld::weld_identical(self)
     }
 }
+
+/// Small meshes for unit tests.
+#[cfg(test)]
+pub(crate) mod shapes {
+    use super::Mesh;
+    use glam::DVec3;
+
+    /// Appends an outward tetrahedron with its right-angled corner at `at` and legs `s` long.
+    pub fn add_tetrahedron(mesh: &mut Mesh, at: DVec3, s: f64) {
+        let first = mesh.positions.len() as u32;
+        mesh.positions.extend([at, at + DVec3::X * s, at + DVec3::Y * s, at + DVec3::Z * s]);
+        let [a, b, c, d] = [first, first + 1, first + 2, first + 3];
+        mesh.triangles.extend([[a, c, b], [a, b, d], [a, d, c], [b, c, d]]);
+    }
+}

@@ -186,8 +186,9 @@ mod tests {
     use glam::DVec3;
 
     fn tetrahedron() -> Mesh {
-        let p = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
-        Mesh::new(p, vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]])
+        let mut mesh = Mesh::default();
+        crate::mesh::shapes::add_tetrahedron(&mut mesh, DVec3::ZERO, 1.0);
+        mesh
     }
 
     #[test]

@@ -145,14 +145,7 @@ fn is_flat([a, b, c]: [DVec3; 3]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// An outward tetrahedron scaled by `s` at `at`, as its own vertices and triangles.
-    fn tetrahedron(mesh: &mut Mesh, at: DVec3, s: f64) {
-        let first = mesh.positions.len() as u32;
-        mesh.positions.extend([at, at + DVec3::X * s, at + DVec3::Y * s, at + DVec3::Z * s]);
-        let [a, b, c, d] = [first, first + 1, first + 2, first + 3];
-        mesh.triangles.extend([[a, c, b], [a, b, d], [a, d, c], [b, c, d]]);
-    }
+    use crate::mesh::shapes::add_tetrahedron as tetrahedron;
 
     #[test]
     fn keeps_the_largest_piece_and_drops_islands_degenerates_and_unused_vertices() {
