@@ -46,13 +46,8 @@ impl DriveState {
 
     /// The state with this wire value.
     pub const fn from_u8(raw: u8) -> Option<Self> {
-        match raw {
-            0 => Some(Self::Disabled),
-            1 => Some(Self::Enabled),
-            2 => Some(Self::Homing),
-            3 => Some(Self::Fault),
-            _ => None,
-        }
+        // `ALL` is in wire-value order, from 0.
+        if (raw as usize) < Self::ALL.len() { Some(Self::ALL[raw as usize]) } else { None }
     }
 }
 
@@ -77,13 +72,8 @@ impl DriveCommand {
 
     /// The command with this wire value.
     pub const fn from_u8(raw: u8) -> Option<Self> {
-        match raw {
-            0 => Some(Self::Disable),
-            1 => Some(Self::Enable),
-            2 => Some(Self::FaultReset),
-            3 => Some(Self::Halt),
-            _ => None,
-        }
+        // `ALL` is in wire-value order, from 0.
+        if (raw as usize) < Self::ALL.len() { Some(Self::ALL[raw as usize]) } else { None }
     }
 }
 
@@ -227,16 +217,8 @@ impl AckStatus {
 
     /// The status with this wire value.
     pub const fn from_u8(raw: u8) -> Option<Self> {
-        match raw {
-            0 => Some(Self::Ok),
-            1 => Some(Self::UnsupportedMessage),
-            2 => Some(Self::InvalidState),
-            3 => Some(Self::InvalidArgument),
-            4 => Some(Self::UnknownParameter),
-            5 => Some(Self::ReadOnlyParameter),
-            6 => Some(Self::IncompatibleVersion),
-            _ => None,
-        }
+        // `ALL` is in wire-value order, from 0.
+        if (raw as usize) < Self::ALL.len() { Some(Self::ALL[raw as usize]) } else { None }
     }
 }
 

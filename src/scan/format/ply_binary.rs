@@ -217,8 +217,8 @@ fn decode(cursor: &mut Cursor, header: &Header, layouts: &[Layout]) -> Result<Me
             }
             (_, Layout::Face(types, list)) => {
                 let vertices = positions.len();
-                triangles = match fixed_triangles(cursor, element.count, types, *list) {
-                    Some(records) => decode_triangles(records, types, *list, big_endian, vertices)?,
+                triangles = match fixed_triangles(cursor, element.count, types) {
+                    Some(records) => decode_triangles(records, big_endian, vertices)?,
                     None => read_polygons(cursor, element.count, types, *list, vertices)?,
                 };
             }
@@ -227,59 +227,57 @@ fn decode(cursor: &mut Cursor, header: &Header, layouts: &[Layout]) -> Result<Me
     Ok(Mesh::new(positions, triangles))
 }
 
-/// The face records, when every one of the `count` faces is a triangle (so all have one
-/// size); the cursor moves past them. `None` (cursor unmoved) otherwise. Exact: if the face
-/// at record `k` is a triangle, face `k + 1` starts at record `k + 1`.
+/// Face records that are all triangles, so all of one size.
+struct TriangleRecords<'a> {
+    bytes: &'a [u8],
+    /// Bytes per face.
+    size: usize,
+    /// Where the first vertex index starts in a face.
+    first_index: usize,
+    index_type: Num,
+}
+
+/// The face records, when every one of the `count` faces (laid out as `types`, whose one list
+/// is the index list) is a triangle; the cursor moves past them. `None` (cursor unmoved)
+/// otherwise. Exact: if the face at record `k` is a triangle, face `k + 1` starts at record
+/// `k + 1`.
 fn fixed_triangles<'a>(
     cursor: &mut Cursor<'a>,
     count: usize,
     types: &[Property],
-    list: usize,
-) -> Option<&'a [u8]> {
-    let mut size = 0;
-    let mut count_at = 0;
-    for (k, t) in types.iter().enumerate() {
+) -> Option<TriangleRecords<'a>> {
+    let (mut size, mut count_at, mut count_type, mut index_type) = (0, 0, Num::U8, Num::U32);
+    for t in types {
         match *t {
             Property::Scalar(s) => size += s.size(),
-            Property::List(count_type, index_type) => {
-                count_at = size;
-                size += count_type.size() + 3 * index_type.size();
-                if k != list || matches!(index_type, Num::F32 | Num::F64) {
-                    return None;
-                }
+            Property::List(c, i) => {
+                (count_at, count_type, index_type) = (size, c, i);
+                size += c.size() + 3 * i.size();
             }
         }
     }
-    let Property::List(count_type, _) = types[list] else { return None };
-    let records = cursor.bytes.get(cursor.at..cursor.at.checked_add(count.checked_mul(size)?)?)?;
-    let triangle = |r: &[u8]| integer(&r[count_at..], count_type, cursor.big_endian) == Some(3);
-    if !records.par_chunks_exact(size).all(triangle) {
+    if matches!(index_type, Num::F32 | Num::F64) {
         return None;
     }
-    cursor.at += records.len();
-    Some(records)
+    let bytes = cursor.bytes.get(cursor.at..cursor.at.checked_add(count.checked_mul(size)?)?)?;
+    let triangle = |r: &[u8]| integer(&r[count_at..], count_type, cursor.big_endian) == Some(3);
+    if !bytes.par_chunks_exact(size).all(triangle) {
+        return None;
+    }
+    cursor.at += bytes.len();
+    Some(TriangleRecords { bytes, size, first_index: count_at + count_type.size(), index_type })
 }
 
-/// Decodes fixed-size triangle records (see [`fixed_triangles`]) in parallel, checking that
-/// every index names one of the `vertices`.
+/// Decodes triangle records in parallel, checking that every index names one of the
+/// `vertices`.
 fn decode_triangles(
-    records: &[u8],
-    types: &[Property],
-    list: usize,
+    records: TriangleRecords,
     big_endian: bool,
     vertices: usize,
 ) -> Result<Vec<[u32; 3]>, ReadError> {
-    let size_of = |t: &Property| match *t {
-        Property::Scalar(s) => s.size(),
-        Property::List(c, i) => c.size() + 3 * i.size(),
-    };
-    let stride: usize = types.iter().map(size_of).sum();
-    let Property::List(count_type, index_type) = types[list] else {
-        return Err(not_an_index());
-    };
-    let first = types[..list].iter().map(size_of).sum::<usize>() + count_type.size();
+    let TriangleRecords { bytes, size, first_index, index_type } = records;
     let raw = |r: &[u8], k: usize| {
-        integer(&r[first + k * index_type.size()..], index_type, big_endian).unwrap_or(-1)
+        integer(&r[first_index + k * index_type.size()..], index_type, big_endian).unwrap_or(-1)
     };
     let in_range = |i: i64| usize::try_from(i).is_ok_and(|i| i < vertices);
     // One pass decodes and checks; a bad index is only located (for the message) afterwards.
@@ -294,9 +292,9 @@ fn decode_triangles(
         }
     };
     let triangles: Vec<[u32; 3]> =
-        records.par_chunks_exact(stride).map(|r| [index(r, 0), index(r, 1), index(r, 2)]).collect();
+        bytes.par_chunks_exact(size).map(|r| [index(r, 0), index(r, 1), index(r, 2)]).collect();
     if bad.load(Ordering::Relaxed) {
-        for (face, r) in records.chunks_exact(stride).enumerate() {
+        for (face, r) in bytes.chunks_exact(size).enumerate() {
             if let Some(index) = (0..3).map(|k| raw(r, k)).find(|&i| !in_range(i)) {
                 return Err(ReadError::IndexOutOfRange { face, index, vertices });
             }
