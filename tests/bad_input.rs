@@ -1,7 +1,7 @@
 //! One test per class of bad input, through the `dressform` binary: a clear message naming the
 //! file, exit status 2 for errors, a warning (and status 0) for problems that are repaired.
 
-mod common;
+use crate::common;
 
 use common::dressform;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! The canonical frame on the MakeHuman body: units, up axis, height and facing are found in
 //! whatever units, up axis, format and turn the body comes in.
 
-mod common;
+use crate::common;
 
 use common::{dressform, makehuman};
 use dressform::mesh::Mesh;

@@ -1,6 +1,6 @@
 //! `dressform demo`: the built-in customer through the whole system, with outputs.
 
-mod common;
+use crate::common;
 
 #[test]
 fn demo_runs_end_to_end_and_writes_its_outputs() {

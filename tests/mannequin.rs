@@ -2,7 +2,7 @@
 //! 1 mm, the torso within 2 mm of the input surface, a closed, manifold, consistently oriented
 //! mesh; and the `symmetrize`, `measure` and `slice` commands with their error paths.
 
-mod common;
+use crate::common;
 
 use common::{SurfaceDistance, dressform, largest_mirror_gap, makehuman};
 use dressform::mannequin::MannequinOptions;

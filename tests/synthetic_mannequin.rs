@@ -2,7 +2,7 @@
 //! body comes out mirror-symmetric with its girths, and a scan with scanner artifacts (noise,
 //! holes, metres, Y up, turned) still gives the customer's known measurements.
 
-mod common;
+use crate::common;
 
 use common::largest_mirror_gap;
 use dressform::mannequin::MannequinOptions;

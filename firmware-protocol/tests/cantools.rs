@@ -5,7 +5,7 @@
 //! Needs `python3` with cantools (`python3 -m pip install cantools`). Without it the test
 //! prints why and passes, unless `DRESSFORM_REQUIRE_PEERS=1` (as in CI), where it fails.
 
-mod strategies;
+use crate::strategies;
 
 use std::collections::BTreeMap;
 use std::io::Write;

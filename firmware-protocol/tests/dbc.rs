@@ -1,7 +1,7 @@
 //! The DBC file is generated from the Rust types, describes exactly the bytes the encoder
 //! writes, and the committed `dressform.dbc` is the generated one.
 
-mod strategies;
+use crate::strategies;
 
 use std::path::Path;
 

@@ -1,7 +1,7 @@
 //! Property tests: every packet round-trips through both mappings; the decoders reject, and
 //! never panic on, arbitrary frames and bytes; corrupted serial frames fail their CRC.
 
-mod strategies;
+use crate::strategies;
 
 use embedded_can::{ExtendedId, Frame as _, Id, StandardId};
 use firmware_protocol::{Error, can, serial};

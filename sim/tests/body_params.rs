@@ -1,10 +1,8 @@
 //! Parameter validation: every invalid value is refused with an error naming its field, never
 //! a panic; bodies at the corners of the allowed ranges generate.
 
-#[path = "support/section.rs"]
-mod section;
-#[path = "support/topology.rs"]
-mod topology;
+use crate::section;
+use crate::topology;
 
 use rayon::prelude::*;
 use sim::capture::{BodyParams, ParamError, generate};

@@ -2,7 +2,7 @@
 //! `firmware-protocol/README.md`: the frames and bus time of a full-form update, and the load
 //! of 50 updates a second with the reference form's cyclic feedback and heartbeats.
 
-mod test_host;
+use crate::test_host;
 
 use firmware_protocol::message::Sync;
 use firmware_protocol::update::{self, NodeTargets};

@@ -1,8 +1,7 @@
 //! Scanner artifacts: exact unit and axis conversions, holes with boundary loops at the
 //! requested places, noise of the requested deviation, determinism.
 
-#[path = "support/topology.rs"]
-mod topology;
+use crate::topology;
 
 use std::sync::OnceLock;
 

@@ -1,7 +1,7 @@
 //! Fault specs on the simulated reference form (in-process CAN, paused clock): node reboots,
 //! silence and slow answers, jammed actuators and broken encoders, as a host sees them.
 
-mod test_host;
+use crate::test_host;
 
 use firmware_protocol::drive::{DriveState, EmergencyCode, Faults};
 use firmware_protocol::message::{Positions8, Sync};

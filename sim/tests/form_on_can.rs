@@ -2,7 +2,7 @@
 //! tokio's paused clock: the acceptance checks for motion, limits, the watchdog and
 //! the emergency stop, and determinism.
 
-mod test_host;
+use crate::test_host;
 
 use std::collections::HashMap;
 

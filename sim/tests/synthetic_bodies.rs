@@ -1,10 +1,8 @@
 //! Synthetic bodies: closed, manifold, one piece, and with the requested tape girths on the
 //! mesh itself, for random parameter sets and the asymmetric pose.
 
-#[path = "support/section.rs"]
-mod section;
-#[path = "support/topology.rs"]
-mod topology;
+use crate::section;
+use crate::topology;
 
 use rayon::prelude::*;
 use sim::capture::{BodyParams, GirthLevel, Pose, SyntheticBody, generate};

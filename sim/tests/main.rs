@@ -1,0 +1,21 @@
+//! The integration tests of this crate, as one test binary (each module was its own binary;
+//! one binary links the crate once).
+
+#[path = "support/section.rs"]
+mod section;
+mod test_host;
+#[path = "support/topology.rs"]
+mod topology;
+
+mod body_params;
+mod bus_budget;
+mod can_bus;
+mod capture_artifacts;
+mod fault_injection;
+mod form_description;
+mod form_on_can;
+mod node_state_machine;
+mod serial_pty;
+mod slcan_pty;
+mod slcan_python_can;
+mod synthetic_bodies;

@@ -1,0 +1,23 @@
+//! The integration tests of this crate, as one test binary (each module was its own binary;
+//! one binary links the crate once).
+
+mod common;
+
+mod analytic_sections;
+mod bad_input;
+mod canonical_frame;
+mod controller_cli;
+mod controller_pty;
+mod controller_safety;
+mod controller_setpoints;
+mod controller_sim;
+mod controller_socketcan;
+mod demo;
+mod fitting;
+mod formats;
+mod fuzz_readers;
+mod mannequin;
+mod run_end_to_end;
+mod sim_cli;
+mod synthetic_bodies;
+mod synthetic_mannequin;
