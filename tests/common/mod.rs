@@ -3,6 +3,25 @@
 
 use std::path::PathBuf;
 
+/// Whether the environment variable `var` is set to `1` (CI sets `DRESSFORM_REQUIRE_SHARED` and
+/// `DRESSFORM_REQUIRE_PEERS`).
+fn required(var: &str) -> bool {
+    std::env::var(var).is_ok_and(|v| v == "1")
+}
+
+/// `Some(found)`, or `None` after printing why the test is skipped; with `require_var=1` (as
+/// in CI) a missing `what` fails the test instead. The one place that decides "skip or fail".
+pub fn or_skip<T>(found: Result<T, String>, what: &str, require_var: &str) -> Option<T> {
+    match found {
+        Ok(t) => Some(t),
+        Err(why) => {
+            assert!(!required(require_var), "{require_var}=1 but {what} is unavailable: {why}");
+            eprintln!("SKIPPED: {what} is unavailable: {why}");
+            None
+        }
+    }
+}
+
 /// The MakeHuman assets (`$DRESSFORM_MAKEHUMAN`, else `../shared/makehuman` beside the
 /// project), or `None` with a message when they are absent. With `DRESSFORM_REQUIRE_SHARED=1`
 /// (as in CI) their absence fails the test instead of skipping it.
@@ -10,13 +29,40 @@ pub fn makehuman() -> Option<PathBuf> {
     let dir = std::env::var_os("DRESSFORM_MAKEHUMAN")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/makehuman"));
-    if dir.join("base.obj").is_file() {
-        return Some(dir);
-    }
-    let required = std::env::var("DRESSFORM_REQUIRE_SHARED").is_ok_and(|v| v == "1");
-    assert!(!required, "DRESSFORM_REQUIRE_SHARED=1 but {} has no base.obj", dir.display());
-    eprintln!("SKIPPED: MakeHuman assets not found at {} (set DRESSFORM_MAKEHUMAN)", dir.display());
-    None
+    let found = if dir.join("base.obj").is_file() {
+        Ok(dir.clone())
+    } else {
+        Err(format!("{} has no base.obj (set DRESSFORM_MAKEHUMAN)", dir.display()))
+    };
+    or_skip(found, "the MakeHuman assets", "DRESSFORM_REQUIRE_SHARED")
+}
+
+/// What the Khronos glTF validator said about a file.
+#[derive(Debug)]
+pub struct GltfReport {
+    pub errors: u64,
+    pub warnings: u64,
+    /// The validator's whole report (JSON), for messages.
+    pub json: serde_json::Value,
+}
+
+/// Runs the Khronos glTF validator (npm `gltf-validator`, found through `$NODE_PATH` as
+/// `.ci/run` installs it) on `file`; `None` (skipped, or failing with
+/// `DRESSFORM_REQUIRE_PEERS=1`) when node or the validator is missing.
+pub fn validate_gltf(file: &std::path::Path) -> Option<GltfReport> {
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/common/validate_gltf.js");
+    let run = std::process::Command::new("node").arg(&script).arg(file).output();
+    let found = match run {
+        Err(e) => Err(format!("cannot run node: {e}")),
+        Ok(out) if !out.status.success() => {
+            Err(format!("node: {}", String::from_utf8_lossy(&out.stderr).trim()))
+        }
+        Ok(out) => serde_json::from_slice::<serde_json::Value>(&out.stdout)
+            .map_err(|e| format!("unreadable validator report: {e}")),
+    };
+    let json = or_skip(found, "the glTF validator (npm gltf-validator)", "DRESSFORM_REQUIRE_PEERS")?;
+    let count = |k: &str| json["issues"][k].as_u64().unwrap_or(u64::MAX);
+    Some(GltfReport { errors: count("numErrors"), warnings: count("numWarnings"), json })
 }
 
 /// Runs the `dressform` binary with `args`; returns (exit code, stdout, stderr).
