@@ -2,6 +2,7 @@
 //! 3D Mannequin Reconstruction Based on 3D Scanning"), and the robotic dress form they drive.
 //!
 //! Modules follow the pipeline:
+//! - [`body_model`]: the statistical body model (paper 3.1.1): PCA shape space, MVC joints, skinning, glTF;
 //! - [`mesh`]: the one triangle-mesh type, its topology and components;
 //! - [`scan`]: reading OBJ/PLY/STL, validation and cleaning, the canonical body frame;
 //! - [`slice`]: horizontal cross-sections and their girths;
@@ -18,6 +19,7 @@
 //! - [`makehuman`]: the CC0 MakeHuman assets (base mesh, targets, 163-bone rig, weights) and posing them;
 //! - [`skinning`]: linear blend skinning (eq. 3) and its angle convention.
 
+pub mod body_model;
 pub mod controller;
 pub mod fitting;
 pub mod makehuman;

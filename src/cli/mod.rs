@@ -30,6 +30,7 @@ mod drive;
 mod estop;
 mod info;
 mod measure;
+mod model;
 mod run;
 mod setpoints;
 mod sim;
@@ -74,6 +75,8 @@ enum Command {
     Status(status::StatusArgs),
     /// Broadcast an emergency stop to every node of the robotic form.
     Estop(estop::EstopArgs),
+    /// The statistical body model: build it, describe it, sample bodies from it.
+    Model(model::ModelArgs),
 }
 
 /// How the scan's frame is given on the command line (all optional: detected by default).
@@ -138,6 +141,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         Command::Drive(a) => drive::run(&a),
         Command::Status(a) => status::run(&a),
         Command::Estop(a) => estop::run(&a),
+        Command::Model(a) => model::run(&a),
     }
 }
 
