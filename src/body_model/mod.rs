@@ -89,7 +89,10 @@ impl BodyModel {
 
     /// The joints of any body in the template's topology (eq. 1): `j_n = sum_i m^n_i v_i`.
     pub fn regress_joints(&self, vertices: &[DVec3]) -> Vec<DVec3> {
-        self.regressor.iter().map(|m| m.iter().zip(vertices).map(|(w, v)| *w * *v).sum()).collect()
+        self.regressor
+            .par_iter()
+            .map(|m| m.iter().zip(vertices).map(|(w, v)| *w * *v).sum())
+            .collect()
     }
 
     /// The rest joints of shape `beta`: `J_0 + sum_k beta_k (R d_k)`.
