@@ -18,6 +18,7 @@ mod formats;
 mod fuzz_readers;
 mod mannequin;
 mod run_end_to_end;
+mod segmentation;
 mod sim_cli;
 mod synthetic_bodies;
 mod synthetic_mannequin;
