@@ -16,6 +16,7 @@ mod demo;
 mod fitting;
 mod formats;
 mod fuzz_readers;
+mod makehuman;
 mod mannequin;
 mod run_end_to_end;
 mod segmentation;
