@@ -235,6 +235,15 @@ impl Node {
         }
     }
 
+    /// Repairs one of its actuators at `now` (see [`ActuatorFault`]): no longer jammed, its
+    /// encoder working; latched faults stay until a FaultReset.
+    pub fn repair(&mut self, now: Instant, actuator: Actuator) {
+        self.advance(now);
+        if let Some(a) = self.actuators.get_mut(actuator.index()) {
+            a.repair(now);
+        }
+    }
+
     /// Lets time pass up to `now`: motion, homing, monitoring, the watchdog and cyclic
     /// frames.
     pub fn tick(&mut self, now: Instant) {
