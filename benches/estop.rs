@@ -24,6 +24,10 @@ const POLL: Duration = Duration::from_micros(200);
 /// One try: start a slow drive, wait until a panel moves, e-stop from another process, wait
 /// until every node latched. Returns the latency; the drive must end with status 1.
 fn one_try(server: &Server, flag: &str, setpoints: &str) -> Duration {
+    // The last try's panels brake to a stop first: "moving" must be this try's move.
+    while server.form().state().actuators.iter().any(|a| a.state.moving) {
+        std::thread::sleep(Duration::from_millis(2));
+    }
     let device = server.device_path().to_str().expect("a pty path");
     let mut drive = Command::new(env!("CARGO_BIN_EXE_dressform"))
         .args(["drive", setpoints, flag, device, "--duration", "20"])
@@ -36,10 +40,10 @@ fn one_try(server: &Server, flag: &str, setpoints: &str) -> Duration {
         std::thread::sleep(Duration::from_millis(2));
     }
     let started = Instant::now();
-    let mut estop = Command::new(env!("CARGO_BIN_EXE_dressform"))
+    let estop = Command::new(env!("CARGO_BIN_EXE_dressform"))
         .args(["estop", flag, device])
         .stdout(Stdio::null())
-        .stderr(Stdio::null())
+        .stderr(Stdio::piped())
         .spawn()
         .expect("dressform estop starts");
     let latched = |s: &Server| {
@@ -49,7 +53,8 @@ fn one_try(server: &Server, flag: &str, setpoints: &str) -> Duration {
         std::thread::sleep(POLL);
     }
     let latency = started.elapsed();
-    assert!(estop.wait().expect("estop").success(), "estop failed");
+    let estop = estop.wait_with_output().expect("estop");
+    assert!(estop.status.success(), "estop failed: {}", String::from_utf8_lossy(&estop.stderr));
     assert_eq!(drive.wait().expect("drive").code(), Some(1), "the drive must end stopped");
     latency
 }

@@ -76,6 +76,10 @@ fn spawn_drive(server: &Server, transport: Transport, file: &str) -> Child {
 /// Waits until some panel of the simulated form moves.
 fn wait_moving(server: &Server, child: &mut Child) {
     let deadline = Instant::now() + START_TIMEOUT;
+    // Panels still braking from an earlier stop are not this drive's move.
+    while server.form().state().actuators.iter().any(|a| a.state.moving) {
+        std::thread::sleep(Duration::from_millis(2));
+    }
     while !server.form().state().actuators.iter().any(|a| a.state.moving) {
         if let Some(status) = child.try_wait().unwrap() {
             panic!("drive ended before moving: {status}");

@@ -89,7 +89,7 @@ pub fn own(spec: &LinkSpec) -> Result<Owned, Failure> {
     let endpoint = Endpoint::bind(spec).map_err(Failure::other)?;
     let connection = Connection::open(spec).map_err(Failure::other)?;
     if let Some(endpoint) = &endpoint {
-        endpoint.arm(connection.gate());
+        endpoint.arm(connection.gate()).map_err(Failure::other)?;
     }
     let armed = signals::arm(connection.gate());
     Ok(Owned { connection, _armed: armed, _endpoint: endpoint })

@@ -138,12 +138,22 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(OFFSET, |h, &b| (h ^ u64::from(b)).wrapping_mul(PRIME))
 }
 
+/// The link's gate once it is open; until then, whether an e-stop came meanwhile (it is sent
+/// the moment the link opens, before anything else can be).
+#[derive(Debug, Default)]
+enum Slot {
+    #[default]
+    Opening,
+    StopWhenOpen,
+    Open(Gate),
+}
+
 /// The endpoint of the process that owns a link, answering e-stops on a thread of its own.
 /// Dropping it closes and removes the socket.
 #[derive(Debug)]
 pub struct Endpoint {
     path: PathBuf,
-    gate: Arc<Mutex<Option<Gate>>>,
+    gate: Arc<Mutex<Slot>>,
     closing: Arc<AtomicBool>,
     thread: Option<std::thread::JoinHandle<()>>,
 }
@@ -166,7 +176,7 @@ impl Endpoint {
         }
         let listener = UnixListener::bind(&path).map_err(io)?;
         std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600)).map_err(io)?;
-        let gate: Arc<Mutex<Option<Gate>>> = Arc::default();
+        let gate: Arc<Mutex<Slot>> = Arc::default();
         let closing = Arc::new(AtomicBool::new(false));
         let thread = {
             let (gate, closing) = (Arc::clone(&gate), Arc::clone(&closing));
@@ -178,9 +188,13 @@ impl Endpoint {
         Ok(Some(Self { path, gate, closing, thread: Some(thread) }))
     }
 
-    /// From now on, e-stops go to `gate`.
-    pub fn arm(&self, gate: &Gate) {
-        *self.gate.lock().unwrap_or_else(PoisonError::into_inner) = Some(gate.clone());
+    /// From now on, e-stops go to `gate`; one that came while the link was opening is sent
+    /// now, before the caller can send anything.
+    pub fn arm(&self, gate: &Gate) -> Result<(), super::transport::TransportError> {
+        let mut slot = self.gate.lock().unwrap_or_else(PoisonError::into_inner);
+        let pending = matches!(*slot, Slot::StopWhenOpen);
+        *slot = Slot::Open(gate.clone());
+        if pending { gate.emergency_stop(StopCause::Remote) } else { Ok(()) }
     }
 
     /// The socket's path.
@@ -202,7 +216,7 @@ impl Drop for Endpoint {
 }
 
 /// Answers requests until `closing`.
-fn listen(listener: &UnixListener, gate: &Mutex<Option<Gate>>, closing: &AtomicBool) {
+fn listen(listener: &UnixListener, gate: &Mutex<Slot>, closing: &AtomicBool) {
     for stream in listener.incoming() {
         if closing.load(Ordering::SeqCst) {
             return;
@@ -215,7 +229,7 @@ fn listen(listener: &UnixListener, gate: &Mutex<Option<Gate>>, closing: &AtomicB
 }
 
 /// Reads one request and answers it.
-fn answer(stream: UnixStream, gate: &Mutex<Option<Gate>>) -> io::Result<()> {
+fn answer(stream: UnixStream, gate: &Mutex<Slot>) -> io::Result<()> {
     stream.set_read_timeout(Some(REPLY_TIMEOUT))?;
     stream.set_write_timeout(Some(REPLY_TIMEOUT))?;
     let mut line = String::new();
@@ -223,11 +237,18 @@ fn answer(stream: UnixStream, gate: &Mutex<Option<Gate>>) -> io::Result<()> {
     let reply = if line.trim() != ESTOP {
         format!("failed to understand the request {:?}", line.trim())
     } else {
-        let armed = gate.lock().unwrap_or_else(PoisonError::into_inner).clone();
-        match armed.map(|g| g.emergency_stop(StopCause::Remote)) {
-            Some(Ok(())) => format!("stopped {}", std::process::id()),
-            Some(Err(e)) => format!("failed to send the emergency stop: {e}"),
-            None => "failed to stop: it has not opened the link yet".into(),
+        let mut slot = gate.lock().unwrap_or_else(PoisonError::into_inner);
+        let sent = match &*slot {
+            Slot::Open(gate) => gate.emergency_stop(StopCause::Remote),
+            // Nothing can move before the link opens, and then the stop goes first.
+            Slot::Opening | Slot::StopWhenOpen => {
+                *slot = Slot::StopWhenOpen;
+                Ok(())
+            }
+        };
+        match sent {
+            Ok(()) => format!("stopped {}", std::process::id()),
+            Err(e) => format!("failed to send the emergency stop: {e}"),
         }
     };
     (&stream).write_all(format!("{reply}\n").as_bytes())
