@@ -9,10 +9,10 @@ use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use firmware_protocol::drive::{DriveState, Faults};
-use sim::form::reference;
 use sim::node::ActuatorFault;
-use sim::serve::{ServeConfig, Server, Transport, serve};
-use tokio::runtime::Runtime;
+use sim::serve::{Server, Transport};
+
+use crate::controller_pty::start;
 
 /// How long a drive may take to get moving (discovery and homing take about a second on a
 /// quiet machine).
@@ -20,16 +20,6 @@ const START_TIMEOUT: Duration = Duration::from_secs(30);
 /// How long the nodes may take to latch an e-stop; ~10 ms on a quiet machine (the README
 /// gives the measured latency), this much on a loaded one.
 const LATCH_TIMEOUT: Duration = Duration::from_secs(5);
-
-fn start(transport: Transport) -> (Runtime, Server) {
-    let runtime =
-        tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
-    let server = {
-        let _context = runtime.enter();
-        serve(ServeConfig::new(reference(), transport)).unwrap()
-    };
-    (runtime, server)
-}
 
 fn flag(transport: Transport) -> &'static str {
     match transport {

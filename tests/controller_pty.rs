@@ -14,7 +14,8 @@ use sim::form::reference;
 use sim::serve::{ServeConfig, Server, Transport as Served, serve};
 use tokio::runtime::Runtime;
 
-fn start(transport: Served) -> (Runtime, Server) {
+/// The reference form served on a pty of `transport`, on a runtime of its own.
+pub(crate) fn start(transport: Served) -> (Runtime, Server) {
     let runtime =
         tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
     let server = {

@@ -22,8 +22,9 @@ pub struct EstopArgs {
     form: FormArg,
 }
 
-/// How long the simulated form gets to take the stop before its nodes are shown.
-const SETTLE: Duration = Duration::from_millis(20);
+/// How long the simulated form may take to latch the stop before its nodes are shown
+/// (a few ms; more on a busy machine).
+const SETTLE: Duration = Duration::from_secs(2);
 
 pub fn run(args: &EstopArgs) -> Result<(), Failure> {
     let spec = args.link.spec();
@@ -51,7 +52,11 @@ fn on_sim(args: &EstopArgs) -> Result<(), Failure> {
     let truth = runtime()?.block_on(async {
         let rig = link::simulated(&form, &SimConfig::default())?;
         emergency_stop(&rig.attach()).map_err(Failure::other)?;
-        tokio::time::sleep(SETTLE).await;
+        let deadline = tokio::time::Instant::now() + SETTLE;
+        let latched = |t: &sim::robot::FormState| t.nodes.iter().all(|n| !n.faults.is_empty());
+        while !latched(&rig.truth()) && tokio::time::Instant::now() < deadline {
+            tokio::time::sleep(Duration::from_millis(1)).await;
+        }
         Ok::<_, Failure>(rig.truth())
     })?;
     outln!("a simulated form started for this command (it ends with it):");
