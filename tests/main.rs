@@ -7,6 +7,7 @@ mod analytic_sections;
 mod bad_input;
 mod canonical_frame;
 mod controller_cli;
+mod controller_estop;
 mod controller_pty;
 mod controller_safety;
 mod controller_setpoints;
