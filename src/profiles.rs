@@ -181,9 +181,20 @@ impl Profiles {
             ("right_armpit", l.right_armpit),
             ("neck", l.neck),
             ("centre_x", l.centre_x),
-            ("arm_cut", l.arm_cut),
         ] {
             place(format!("landmarks.{name}"), value);
+        }
+        for (side, armhole) in [("left", &l.left_armhole), ("right", &l.right_armhole)] {
+            for (name, point) in
+                [("armpit", armhole.armpit), ("shoulder_point", armhole.shoulder_point)]
+            {
+                for (c, value) in point.to_array().into_iter().enumerate() {
+                    place(format!("landmarks.{side}_armhole.{name}[{c}]"), value);
+                }
+            }
+            for (c, value) in armhole.normal.to_array().into_iter().enumerate() {
+                place(format!("landmarks.{side}_armhole.normal[{c}]"), value);
+            }
         }
         for (i, layer) in self.layers.iter().enumerate() {
             place(format!("layers[{i}].z"), layer.z);

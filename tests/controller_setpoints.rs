@@ -147,7 +147,13 @@ fn profiles(points: usize) -> serde_json::Value {
         "rays": points + 2, "preserve": "tape",
         "levels": { "chest": 1250.0, "waist": 1060.0, "hip": 880.0 },
         "landmarks": { "height": 1700.0, "crotch": 780.0, "ankle": 80.0, "left_armpit": 1290.0,
-                       "right_armpit": 1290.0, "neck": 1470.0, "centre_x": 0.0, "arm_cut": 180.0 },
+                       "right_armpit": 1290.0, "neck": 1470.0, "centre_x": 0.0,
+                       "left_armhole": { "armpit": [150.0, 0.0, 1290.0],
+                                         "shoulder_point": [190.0, 0.0, 1420.0],
+                                         "normal": [0.956, 0.0, -0.294] },
+                       "right_armhole": { "armpit": [-150.0, 0.0, 1290.0],
+                                          "shoulder_point": [-190.0, 0.0, 1420.0],
+                                          "normal": [-0.956, 0.0, -0.294] } },
         "layers": layers
     })
 }
