@@ -6,10 +6,10 @@
 //!   "frame": "canonical: mm, Z up, floor at z = 0, +X = subject's left, facing -Y",
 //!   "axis_x": 0.0,                    // the symmetry plane x = axis_x
 //!   "rays": 360, "preserve": "tape",
-//!   "levels": { "chest": .., "waist": .., "hip": .. },   // measurement levels (mm)
-//!   "landmarks": { "height": .., "crotch": .., "ankle": .., "left_armpit": .., "right_armpit": ..,
-//!                  "neck": .., "centre_x": .., "left_armhole": {"armpit": [x, y, z],
-//!                  "shoulder_point": [x, y, z], "normal": [x, y, z]}, "right_armhole": .. },
+//!   "levels": { "chest_mm": .., "waist_mm": .., "hip_mm": .. },   // measurement levels
+//!   "landmarks": { "height_mm": .., "crotch_mm": .., "ankle_mm": .., "left_armpit_mm": .., "right_armpit_mm": ..,
+//!                  "neck_mm": .., "centre_x_mm": .., "left_armhole": {"armpit_mm": [x, y, z],
+//!                  "shoulder_point_mm": [x, y, z], "normal": [x, y, z]}, "right_armhole": .. },
 //!   "layers": [                       // legs (left, right), then torso; each bottom to top
 //!     { "region": "torso" | "left_leg" | "right_leg",
 //!       "z": 812.5, "centre": [x, y],

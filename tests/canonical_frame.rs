@@ -120,10 +120,7 @@ fn overrides_win_over_detection() {
 /// The generator's default customer written as a millimetre, Z-up PLY.
 fn millimetre_z_up_scan(dir: &Path) -> std::path::PathBuf {
     let body = sim::capture::generate(&sim::capture::BodyParams::default()).unwrap();
-    let mesh = Mesh::new(
-        body.surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
-        body.surface.triangles.clone(),
-    );
+    let mesh = common::mesh_of(&body);
     let path = dir.join("customer_mm_z_up.ply");
     write_atomically(&path, &Format::Ply.encode(&mesh)).unwrap();
     path

@@ -4,19 +4,12 @@
 
 use crate::common;
 
-use common::makehuman;
+use common::{makehuman, mesh_of};
 use dressform::mesh::Mesh;
 use dressform::regions::{Armhole, BodyRegions, TRACKING_STEP_MM};
 use dressform::scan::{self, frame::FrameOptions};
 use glam::DVec3;
-use sim::capture::{BodyParams, Pose, SyntheticBody, generate};
-
-fn mesh_of(body: &SyntheticBody) -> Mesh {
-    Mesh::new(
-        body.surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
-        body.surface.triangles.clone(),
-    )
-}
+use sim::capture::{BodyParams, Pose, generate};
 
 /// Spacing of the torso sections compared for the width jump (the mannequin's own rule).
 const JUMP_STEP_MM: f64 = 2.0;

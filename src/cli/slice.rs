@@ -114,7 +114,7 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
     for s in &out.sections {
         outln!("  z = {:.1} mm: {} loops", s.z_mm, s.loops.len());
         for l in &s.loops {
-            let label = l.label.map_or("unlabelled".to_string(), |r| format!("{r:?}"));
+            let label = l.label.map_or("unlabelled", |r| r.name());
             outln!(
                 "    {label:<10} contour {:8.1} mm  tape girth {:8.1} mm  at ({:.0}, {:.0})",
                 l.perimeter_mm,
