@@ -169,21 +169,27 @@ impl Profiles {
         };
         place("axis_x".into(), self.axis_x);
         let Levels { chest, waist, hip } = self.levels;
-        for (name, value) in [("chest", chest), ("waist", waist), ("hip", hip)] {
+        for (name, value) in [("chest_mm", chest), ("waist_mm", waist), ("hip_mm", hip)] {
             place(format!("levels.{name}"), value);
         }
         let l = &self.landmarks;
         for (name, value) in [
-            ("height", l.height),
-            ("crotch", l.crotch),
-            ("ankle", l.ankle),
-            ("left_armpit", l.left_armpit),
-            ("right_armpit", l.right_armpit),
-            ("neck", l.neck),
-            ("centre_x", l.centre_x),
-            ("arm_cut", l.arm_cut),
+            ("height_mm", l.height),
+            ("crotch_mm", l.crotch),
+            ("ankle_mm", l.ankle),
+            ("left_armpit_mm", l.left_armpit),
+            ("right_armpit_mm", l.right_armpit),
+            ("neck_mm", l.neck),
+            ("centre_x_mm", l.centre_x),
         ] {
             place(format!("landmarks.{name}"), value);
+        }
+        for (name, a) in [("left_armhole", &l.left_armhole), ("right_armhole", &l.right_armhole)] {
+            for (part, p) in [("armpit_mm", a.armpit), ("shoulder_point_mm", a.shoulder_point)] {
+                for (c, v) in p.to_array().into_iter().enumerate() {
+                    place(format!("landmarks.{name}.{part}[{c}]"), v);
+                }
+            }
         }
         for (i, layer) in self.layers.iter().enumerate() {
             place(format!("layers[{i}].z"), layer.z);
