@@ -6,10 +6,10 @@
 //!   "frame": "canonical: mm, Z up, floor at z = 0, +X = subject's left, facing -Y",
 //!   "axis_x": 0.0,                    // the symmetry plane x = axis_x
 //!   "rays": 360, "preserve": "tape",
-//!   "levels": { "chest": .., "waist": .., "hip": .. },   // measurement levels (mm)
-//!   "landmarks": { "height": .., "crotch": .., "ankle": .., "left_armpit": .., "right_armpit": ..,
-//!                  "neck": .., "centre_x": .., "left_armhole": {"armpit": [x, y, z],
-//!                  "shoulder_point": [x, y, z], "normal": [x, y, z]}, "right_armhole": .. },
+//!   "levels": { "chest_mm": .., "waist_mm": .., "hip_mm": .. },   // measurement levels
+//!   "landmarks": { "height_mm": .., "crotch_mm": .., "ankle_mm": .., "left_armpit_mm": .., "right_armpit_mm": ..,
+//!                  "neck_mm": .., "centre_x_mm": .., "left_armhole": {"armpit_mm": [x, y, z],
+//!                  "shoulder_point_mm": [x, y, z], "normal": [x, y, z]}, "right_armhole": .. },
 //!   "layers": [                       // legs (left, right), then torso; each bottom to top
 //!     { "region": "torso" | "left_leg" | "right_leg",
 //!       "z": 812.5, "centre": [x, y],
@@ -169,31 +169,26 @@ impl Profiles {
         };
         place("axis_x".into(), self.axis_x);
         let Levels { chest, waist, hip } = self.levels;
-        for (name, value) in [("chest", chest), ("waist", waist), ("hip", hip)] {
+        for (name, value) in [("chest_mm", chest), ("waist_mm", waist), ("hip_mm", hip)] {
             place(format!("levels.{name}"), value);
         }
         let l = &self.landmarks;
         for (name, value) in [
-            ("height", l.height),
-            ("crotch", l.crotch),
-            ("ankle", l.ankle),
-            ("left_armpit", l.left_armpit),
-            ("right_armpit", l.right_armpit),
-            ("neck", l.neck),
-            ("centre_x", l.centre_x),
+            ("height_mm", l.height),
+            ("crotch_mm", l.crotch),
+            ("ankle_mm", l.ankle),
+            ("left_armpit_mm", l.left_armpit),
+            ("right_armpit_mm", l.right_armpit),
+            ("neck_mm", l.neck),
+            ("centre_x_mm", l.centre_x),
         ] {
             place(format!("landmarks.{name}"), value);
         }
-        for (side, armhole) in [("left", &l.left_armhole), ("right", &l.right_armhole)] {
-            for (name, point) in
-                [("armpit", armhole.armpit), ("shoulder_point", armhole.shoulder_point)]
-            {
-                for (c, value) in point.to_array().into_iter().enumerate() {
-                    place(format!("landmarks.{side}_armhole.{name}[{c}]"), value);
+        for (name, a) in [("left_armhole", &l.left_armhole), ("right_armhole", &l.right_armhole)] {
+            for (part, p) in [("armpit_mm", a.armpit), ("shoulder_point_mm", a.shoulder_point)] {
+                for (c, v) in p.to_array().into_iter().enumerate() {
+                    place(format!("landmarks.{name}.{part}[{c}]"), v);
                 }
-            }
-            for (c, value) in armhole.normal.to_array().into_iter().enumerate() {
-                place(format!("landmarks.{side}_armhole.normal[{c}]"), value);
             }
         }
         for (i, layer) in self.layers.iter().enumerate() {

@@ -145,15 +145,16 @@ fn profiles(points: usize) -> serde_json::Value {
     serde_json::json!({
         "format": "dressform-profiles/1", "frame": "canonical", "axis_x": 0.0,
         "rays": points + 2, "preserve": "tape",
-        "levels": { "chest": 1250.0, "waist": 1060.0, "hip": 880.0 },
-        "landmarks": { "height": 1700.0, "crotch": 780.0, "ankle": 80.0, "left_armpit": 1290.0,
-                       "right_armpit": 1290.0, "neck": 1470.0, "centre_x": 0.0,
-                       "left_armhole": { "armpit": [150.0, 0.0, 1290.0],
-                                         "shoulder_point": [190.0, 0.0, 1420.0],
-                                         "normal": [0.956, 0.0, -0.294] },
-                       "right_armhole": { "armpit": [-150.0, 0.0, 1290.0],
-                                          "shoulder_point": [-190.0, 0.0, 1420.0],
-                                          "normal": [-0.956, 0.0, -0.294] } },
+        "levels": { "chest_mm": 1250.0, "waist_mm": 1060.0, "hip_mm": 880.0 },
+        "landmarks": { "height_mm": 1700.0, "crotch_mm": 780.0, "ankle_mm": 80.0,
+                       "left_armpit_mm": 1290.0, "right_armpit_mm": 1290.0, "neck_mm": 1470.0,
+                       "centre_x_mm": 0.0,
+                       "left_armhole": { "armpit_mm": [160.0, 20.0, 1290.0],
+                                         "shoulder_point_mm": [190.0, 20.0, 1400.0],
+                                         "normal": [0.96, 0.0, -0.26] },
+                       "right_armhole": { "armpit_mm": [-160.0, 20.0, 1290.0],
+                                          "shoulder_point_mm": [-190.0, 20.0, 1400.0],
+                                          "normal": [-0.96, 0.0, -0.26] } },
         "layers": layers
     })
 }
@@ -224,13 +225,13 @@ fn malformed_profiles_are_refused_naming_the_field() {
         ),
         (
             "a level far away",
-            |p| p["levels"]["waist"] = serde_json::json!(-7000.0),
-            "levels.waist: -7000",
+            |p| p["levels"]["waist_mm"] = serde_json::json!(-7000.0),
+            "levels.waist_mm: -7000",
         ),
         (
             "a landmark far away",
-            |p| p["landmarks"]["neck"] = serde_json::json!(1e300),
-            "landmarks.neck",
+            |p| p["landmarks"]["neck_mm"] = serde_json::json!(1e300),
+            "landmarks.neck_mm",
         ),
         (
             "a negative girth",
