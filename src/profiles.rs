@@ -86,7 +86,31 @@ impl From<&Layer> for ProfileLayer {
     }
 }
 
+/// Why bytes are not a profiles file.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ProfilesError {
+    /// Not JSON of this layout.
+    #[error("not a profiles file: {0}")]
+    Syntax(String),
+    /// Another format or version.
+    #[error("format \"{found}\", expected \"{FORMAT}\"")]
+    Format {
+        /// The file's `format`.
+        found: String,
+    },
+}
+
 impl Profiles {
+    /// Parses a `profiles.json` file's bytes, checking its format tag.
+    pub fn from_json(bytes: &[u8]) -> Result<Profiles, ProfilesError> {
+        let p: Profiles =
+            serde_json::from_slice(bytes).map_err(|e| ProfilesError::Syntax(e.to_string()))?;
+        if p.format != FORMAT {
+            return Err(ProfilesError::Format { found: p.format });
+        }
+        Ok(p)
+    }
+
     /// The profiles of `m`, whose body was measured at `levels`.
     pub fn of(m: &Mannequin, levels: &Levels) -> Self {
         Profiles {

@@ -3,7 +3,7 @@
 
 use super::Failure;
 use dressform::fitting::{Fit, fit};
-use dressform::profiles::{self, Profiles};
+use dressform::profiles::Profiles;
 use dressform::setpoints::SetPoints;
 use sim::form::FormDescription;
 use std::path::{Path, PathBuf};
@@ -27,18 +27,7 @@ pub struct SetpointsArgs {
 pub fn load_profiles(path: &Path) -> Result<Profiles, Failure> {
     let bytes = std::fs::read(path)
         .map_err(|e| Failure::bad_input(format!("{}: cannot read: {e}", path.display())))?;
-    let p: Profiles = serde_json::from_slice(&bytes)
-        .map_err(|e| Failure::bad_input(format!("{}: not a profiles file: {e}", path.display())))?;
-    if p.format != profiles::FORMAT {
-        let message = format!(
-            "{}: format \"{}\", expected \"{}\"",
-            path.display(),
-            p.format,
-            profiles::FORMAT
-        );
-        return Err(Failure::bad_input(message));
-    }
-    Ok(p)
+    Profiles::from_json(&bytes).map_err(|e| Failure::bad_input(format!("{}: {e}", path.display())))
 }
 
 pub fn run(args: &SetpointsArgs) -> Result<(), Failure> {

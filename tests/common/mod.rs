@@ -60,7 +60,8 @@ pub fn validate_gltf(file: &std::path::Path) -> Option<GltfReport> {
         Ok(out) => serde_json::from_slice::<serde_json::Value>(&out.stdout)
             .map_err(|e| format!("unreadable validator report: {e}")),
     };
-    let json = or_skip(found, "the glTF validator (npm gltf-validator)", "DRESSFORM_REQUIRE_PEERS")?;
+    let json =
+        or_skip(found, "the glTF validator (npm gltf-validator)", "DRESSFORM_REQUIRE_PEERS")?;
     let count = |k: &str| json["issues"][k].as_u64().unwrap_or(u64::MAX);
     Some(GltfReport { errors: count("numErrors"), warnings: count("numWarnings"), json })
 }
@@ -180,4 +181,18 @@ pub fn largest_mirror_gap(mesh: &Mesh, axis: f64) -> f64 {
             best
         })
         .fold(0.0, f64::max)
+}
+
+/// A synthetic customer (the sim generator's default body) scanned with a typical scanner's
+/// artifacts (noise, holes, metres, Y up, turned; `seed` picks them), written to
+/// `dir/scan.ply`.
+pub fn synthetic_scan(dir: &std::path::Path, seed: u64) -> PathBuf {
+    use sim::capture::{Artifacts, BodyParams, capture, generate};
+    let body = generate(&BodyParams::default()).expect("the default body generates");
+    let raw = capture(&body, &Artifacts::typical_scanner(seed));
+    let mesh =
+        Mesh::new(raw.positions.iter().map(|&p| DVec3::from_array(p)).collect(), raw.triangles);
+    let path = dir.join("scan.ply");
+    std::fs::write(&path, dressform::scan::format::Format::Ply.encode(&mesh)).expect("writable");
+    path
 }
