@@ -3,7 +3,7 @@
 //!
 //! Layers (defaults from the paper): 100 torso layers from just above the crotch to the neck,
 //! 50 leg layers from the ankles to just below the crotch. Above the armpits the torso sections
-//! are cut at x = `centre_x` ± `arm_cut` (vertical arm plates, as on a dress form), so the arms are not part
+//! are cut off at the armholes ([`crate::regions::Armhole`], as a dress form's arm plates), so the arms are not part
 //! of the torso. All layers share one symmetry plane, x = `axis`: the median of the torso
 //! sections' bounding-box centres.
 

@@ -6,9 +6,13 @@
 //!
 //! Tracking starts from the torso at 60% of the height (between crotch and armpits for any
 //! standing adult) and follows the loop that contains the previous loop's centroid, up and
-//! down. The subject's left is +X in the canonical frame.
+//! down. The subject's left is +X in the canonical frame. Above the armpits the arms are cut
+//! off the torso at the armholes ([`Armhole`]), as a dress form's arm plates cut them.
 
+mod armhole;
 mod tracking;
+
+pub use armhole::Armhole;
 
 use crate::mesh::Mesh;
 use crate::slice::{Contour, Section, sections};
@@ -33,27 +37,48 @@ pub enum Region {
     Head,
 }
 
-/// Landmark heights (mm, canonical frame) and the arm cut.
+impl Region {
+    /// The label as text and JSON spell it: `torso`, `left_leg`, `right_arm`, ...
+    pub fn name(self) -> &'static str {
+        match self {
+            Region::Torso => "torso",
+            Region::LeftLeg => "left_leg",
+            Region::RightLeg => "right_leg",
+            Region::LeftArm => "left_arm",
+            Region::RightArm => "right_arm",
+            Region::Head => "head",
+        }
+    }
+}
+
+/// Landmark heights (mm, canonical frame) and the armholes.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Landmarks {
     /// Body height.
+    #[serde(rename = "height_mm")]
     pub height: f64,
     /// Where the legs join (to 0.1 mm): just above it the torso is one loop.
+    #[serde(rename = "crotch_mm")]
     pub crotch: f64,
     /// The narrowest level of the legs near the floor (the ankles): where the legs end.
+    #[serde(rename = "ankle_mm")]
     pub ankle: f64,
-    /// Where the left arm joins the torso.
+    /// Where the left arm joins the torso: the height of `left_armhole.armpit`.
+    #[serde(rename = "left_armpit_mm")]
     pub left_armpit: f64,
-    /// Where the right arm joins the torso.
+    /// Where the right arm joins the torso: the height of `right_armhole.armpit`.
+    #[serde(rename = "right_armpit_mm")]
     pub right_armpit: f64,
     /// The narrowest torso level between the armpits and the head.
+    #[serde(rename = "neck_mm")]
     pub neck: f64,
     /// The torso's centre line: its bounding-box centre (x) just below the armpits.
+    #[serde(rename = "centre_x_mm")]
     pub centre_x: f64,
-    /// Half-width of the torso just below the armpits: the vertical planes
-    /// x = `centre_x` ± `arm_cut` cut the arms off the torso sections above the armpits, like a
-    /// dress form's arm plates.
-    pub arm_cut: f64,
+    /// Where the left arm is cut off the torso (the subject's left, +X).
+    pub left_armhole: Armhole,
+    /// Where the right arm is cut off the torso.
+    pub right_armhole: Armhole,
 }
 
 impl Landmarks {
@@ -83,11 +108,23 @@ pub enum RegionError {
         /// The height looked at.
         z: f64,
     },
-    /// The torso reaches the floor without splitting into two legs.
+    /// The legs never join below the torso.
     #[error(
-        "no crotch found: the legs do not separate below the torso (legs together, or a skirt?)"
+        "no crotch found: the legs followed up from the shins do not meet below mid-torso \
+         (is this one standing person?)"
     )]
     NoCrotch,
+    /// Not two legs at the shins.
+    #[error(
+        "no crotch found: {loops} loop(s) at z = {z:.0} mm (the shins) where two legs should \
+         be: scan standing with the feet apart (thighs may touch, shins must not)"
+    )]
+    NoLegs {
+        /// The height looked at.
+        z: f64,
+        /// The loops found there.
+        loops: usize,
+    },
     /// No arm loop below the armpits on one side.
     #[error(
         "no {side} arm found beside the torso (arms must hang clear of the torso, as in an A-pose)"
@@ -142,8 +179,8 @@ impl BodyRegions {
     }
 
     /// The torso's section at each of `heights` (`None` where there is none): the largest
-    /// loop labelled torso (at and above the neck, head), with each arm cut off at
-    /// x = `centre_x` ± `arm_cut` above its armpit.
+    /// loop labelled torso (at and above the neck, head), clipped to the inner side of both
+    /// armholes (above each armpit), so that it holds no arm material.
     pub fn torso_sections(&self, body: &Mesh, heights: &[f64]) -> Vec<Option<Contour>> {
         let m = &self.landmarks;
         sections(body, heights)
@@ -152,15 +189,9 @@ impl BodyRegions {
                 let labels = self.label(&s);
                 let found = largest_with(&s, &labels, Region::Torso)
                     .or_else(|| largest_with(&s, &labels, Region::Head));
-                let lo = if s.height > m.right_armpit {
-                    m.centre_x - m.arm_cut
-                } else {
-                    f64::NEG_INFINITY
-                };
-                let hi =
-                    if s.height > m.left_armpit { m.centre_x + m.arm_cut } else { f64::INFINITY };
                 found.map(|c| {
-                    if lo.is_finite() || hi.is_finite() { c.clip_x(lo, hi) } else { c.clone() }
+                    let c = m.left_armhole.clip(c, s.height);
+                    m.right_armhole.clip(&c, s.height)
                 })
             })
             .collect()
@@ -226,8 +257,16 @@ impl BodyRegions {
 fn fallback_region(c: DVec2, z: f64, m: &Landmarks) -> Region {
     match () {
         _ if z >= m.neck => Region::Head,
-        _ if z >= m.crotch && (c.x - m.centre_x).abs() <= m.arm_cut => Region::Torso,
-        _ if z >= m.crotch => side(c.x - m.centre_x, Region::LeftArm, Region::RightArm),
+        _ if z >= m.crotch => {
+            let p = c.extend(z);
+            if m.left_armhole.beyond(p) > 0.0 {
+                Region::LeftArm
+            } else if m.right_armhole.beyond(p) > 0.0 {
+                Region::RightArm
+            } else {
+                Region::Torso
+            }
+        }
         _ => side(c.x - m.centre_x, Region::LeftLeg, Region::RightLeg),
     }
 }
@@ -244,4 +283,24 @@ pub fn largest_with<'a>(
     region: Region,
 ) -> Option<&'a Contour> {
     section.loops.iter().zip(labels).find(|&(_, &r)| r == region).map(|(l, _)| l)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Region;
+
+    #[test]
+    fn labels_are_spelled_alike_in_text_and_json() {
+        let all = [
+            Region::Torso,
+            Region::LeftLeg,
+            Region::RightLeg,
+            Region::LeftArm,
+            Region::RightArm,
+            Region::Head,
+        ];
+        for r in all {
+            assert_eq!(serde_json::to_string(&r).unwrap(), format!("\"{}\"", r.name()));
+        }
+    }
 }

@@ -1,13 +1,11 @@
 //! Tracking loops from level to level to find the landmarks and label every loop.
 
+use super::armhole::{self, Armhole};
 use super::{BodyRegions, LabelledSection, Landmarks, Region, RegionError, side};
 use crate::mesh::Mesh;
 use crate::slice::{Contour, Section, sections};
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
-
-/// A jump of the torso's half-width between two levels that means an arm has joined (mm).
-const ARM_JOIN_JUMP_MM: f64 = 15.0;
 
 /// Index of the largest loop of `s` containing `p` (loops are sorted largest first).
 fn loop_containing(s: &Section, p: DVec2) -> Option<usize> {
@@ -43,9 +41,10 @@ fn x_range(c: &Contour) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)))
 }
 
-/// The crotch between `below` (legs apart) and `above` (one torso loop around `inside`), by
-/// bisection to 0.1 mm, cutting only the part of the body between the two heights.
-fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, inside: DVec2) -> f64 {
+/// The crotch between `below` (the legs apart, their loops around `legs`) and `above` (one
+/// loop around both), by bisection to 0.1 mm, cutting only the part of the body between the
+/// two heights.
+fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, legs: [DVec2; 2]) -> f64 {
     let near = body.part(|tri| {
         let z = tri.map(|v| body.positions[v as usize].z);
         z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
@@ -53,9 +52,60 @@ fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, inside: DVec2) -> 
     while above - below > 0.1 {
         let mid = 0.5 * (below + above);
         let s = &sections(&near, &[mid])[0];
-        if loop_containing(s, inside).is_some() { above = mid } else { below = mid }
+        let [l, r] = legs.map(|c| loop_containing(s, c));
+        if l.is_some() && l == r { above = mid } else { below = mid }
     }
     above
+}
+
+/// Where the legs are picked up, as a fraction of the height: the shins, below any hand
+/// (fingertips hang at 0.38 of the stature or higher) and above the feet (the ankle is at
+/// 0.04, the knee at 0.28: Drillis and Contini).
+const SHIN_LEVEL: f64 = 0.15;
+
+/// The armpit between `below` (the arm's loop `arm` apart from the torso's loop `torso`)
+/// and `above` (joined), by bisection to 0.1 mm: the middle of the narrowest gap between the
+/// arm and the torso just below where they join. The arm grows upward into the join, so a
+/// level holds it apart as long as the torso's loop there does not overlap `arm`.
+fn refine_armpit(
+    body: &Mesh,
+    mut below: f64,
+    mut above: f64,
+    arm: &Contour,
+    torso: &Contour,
+) -> DVec3 {
+    let near = body.part(|tri| {
+        let z = tri.map(|v| body.positions[v as usize].z);
+        z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
+    });
+    let torso_c = torso.centroid();
+    let mut apart = (arm.clone(), torso.clone());
+    while above - below > 0.1 {
+        let mid = 0.5 * (below + above);
+        let s = &sections(&near, &[mid])[0];
+        let torso_here = loop_containing(s, torso_c).map(|t| &s.loops[t]);
+        let arm_here = s.loops.iter().find(|l| overlaps(arm, l));
+        match (torso_here, arm_here) {
+            (Some(t), Some(a)) if !overlaps(arm, t) => {
+                apart = (a.clone(), t.clone());
+                below = mid;
+            }
+            _ => above = mid,
+        }
+    }
+    let (p, q) = armhole::closest_points(&apart.0, &apart.1);
+    (0.5 * (p + q)).extend(above)
+}
+
+/// Whether loop `a` overlaps loop `b` seen from above: a point of `a` lies inside `b`.
+fn overlaps(a: &Contour, b: &Contour) -> bool {
+    a.points.iter().any(|&p| b.contains(p))
+}
+
+/// The x of the middle of a loop's bounding box.
+fn bbox_centre_x(c: &Contour) -> f64 {
+    let (lo, hi) = x_range(c);
+    0.5 * (lo + hi)
 }
 
 /// Tracks loops through `sections`, the body's sections every `step` mm from `floor` (at
@@ -75,56 +125,80 @@ pub(super) fn track(
         return Err(RegionError::NoTorso { z: z_of(seed) });
     }
     let up = follow(&sections, seed..n, 0);
-    let down = follow(&sections, (0..=seed).rev(), 0);
-    let &(crotch_i, crotch_k) = down.last().expect("the seed is tracked");
-    if crotch_i == 0 {
-        return Err(RegionError::NoCrotch);
+
+    // Legs, from their ends: the two largest loops at the shins (below any hand, above the
+    // feet), followed up until both land in one loop (the crotch: where the legs part) and
+    // down to the floor.
+    let shin = ((SHIN_LEVEL * height / step) as usize).min(n - 1);
+    let shins = &sections[shin].loops;
+    if shins.len() < 2 {
+        return Err(RegionError::NoLegs { z: z_of(shin), loops: shins.len() });
     }
+    let (left_k, right_k) =
+        if shins[0].centroid().x > shins[1].centroid().x { (0, 1) } else { (1, 0) };
+    let mut leg: Vec<[Option<usize>; 2]> = vec![[None, None]; n];
+    let mut apart = [shins[left_k].centroid(), shins[right_k].centroid()];
+    let mut crotch_i = None;
+    for i in shin..n {
+        let found = if i == shin {
+            [Some(left_k), Some(right_k)]
+        } else {
+            apart.map(|c| loop_containing(&sections[i], c))
+        };
+        match found {
+            [Some(l), Some(r)] if l == r => {
+                crotch_i = Some(i);
+                break;
+            }
+            [Some(l), Some(r)] => {
+                leg[i] = [Some(l), Some(r)];
+                apart = [sections[i].loops[l].centroid(), sections[i].loops[r].centroid()];
+            }
+            _ => break,
+        }
+    }
+    let Some(crotch_i) = crotch_i.filter(|&i| i <= seed) else {
+        return Err(RegionError::NoCrotch);
+    };
+    for (s, k) in [(0, left_k), (1, right_k)] {
+        for (i, k) in follow(&sections, (0..=shin).rev(), k) {
+            leg[i][s] = Some(k);
+        }
+    }
+    let crotch = refine_crotch(body, z_of(crotch_i - 1), z_of(crotch_i), apart);
+    let down = follow(&sections, (crotch_i..=seed).rev(), 0);
     let mut torso: Vec<Option<usize>> = vec![None; n];
     for &(i, k) in up.iter().chain(&down) {
         torso[i] = Some(k);
     }
 
-    // Legs: below the crotch, the largest loop on each side under the torso, then followed down.
-    let crotch_loop = &sections[crotch_i].loops[crotch_k];
-    let mid = crotch_loop.centroid().x;
-    let (lo, hi) = x_range(crotch_loop);
-    let below = &sections[crotch_i - 1];
-    let under = |want_left: bool| {
-        below.loops.iter().position(|l| {
-            let c = l.centroid();
-            (c.x > mid) == want_left && c.x > lo && c.x < hi
+    // Armpits: going up from the seed, the first level where a loop beside the torso on that
+    // side joins it (a hanging arm at once, a raised arm's underside as a thin sliver).
+    let joining = |sign: f64| {
+        up.windows(2).find_map(|w| {
+            let ((i, t), (_, t_next)) = (w[0], w[1]);
+            let centre = bbox_centre_x(&sections[i].loops[t]);
+            let next = &sections[w[1].0].loops[t_next];
+            (0..sections[i].loops.len())
+                .filter(|&k| k != t)
+                .filter(|&k| sign * (sections[i].loops[k].centroid().x - centre) > 0.0)
+                .find(|&k| overlaps(&sections[i].loops[k], next))
+                .map(|k| (i, t, k))
         })
     };
-    let (Some(left_k), Some(right_k)) = (under(true), under(false)) else {
-        return Err(RegionError::NoCrotch);
+    let (Some(left), Some(right)) = (joining(1.0), joining(-1.0)) else {
+        let side = if joining(1.0).is_none() { "left" } else { "right" };
+        return Err(RegionError::NoArm { side });
     };
-    let mut leg: Vec<[Option<usize>; 2]> = vec![[None, None]; n];
-    for (s, k) in [(0, left_k), (1, right_k)] {
-        for (i, k) in follow(&sections, (0..crotch_i).rev(), k) {
-            leg[i][s] = Some(k);
-        }
-    }
-
-    // Armpits: going up from the seed, the level where the torso suddenly widens on that side.
-    let half_widths: Vec<(usize, f64, f64)> = up
-        .iter()
-        .map(|&(i, k)| {
-            let (lo, hi) = x_range(&sections[i].loops[k]);
-            (i, hi, -lo)
-        })
-        .collect();
-    let armpit = |pick: fn(&(usize, f64, f64)) -> f64, name: &'static str| {
-        half_widths
-            .windows(2)
-            .find(|w| pick(&w[1]) - pick(&w[0]) > ARM_JOIN_JUMP_MM)
-            .map(|w| (0.5 * (z_of(w[0].0) + z_of(w[1].0)), pick(&w[0])))
-            .ok_or(RegionError::NoArm { side: name })
+    // The centre line: the torso's bounding-box centre just below the lower armpit.
+    let (i, t, _) = if left.0 <= right.0 { left } else { right };
+    let centre_x = bbox_centre_x(&sections[i].loops[t]);
+    let armpit_point = |(i, t, k): (usize, usize, usize)| {
+        let (arm, torso_loop) = (&sections[i].loops[k], &sections[i].loops[t]);
+        refine_armpit(body, z_of(i), z_of(i + 1), arm, torso_loop)
     };
-    // The arm planes go where the torso's sides were just below each armpit.
-    let (left_armpit, left_side) = armpit(|w| w.1, "left")?;
-    let (right_armpit, right_side) = armpit(|w| w.2, "right")?;
-    let centre_x = 0.5 * (left_side - right_side);
+    let (left_pit, right_pit) = (armpit_point(left), armpit_point(right));
+    let (left_armpit, right_armpit) = (left_pit.z, right_pit.z);
 
     // Neck: the narrowest torso level between the armpits and the head's widest level.
     let armpit_z = left_armpit.max(right_armpit);
@@ -150,20 +224,25 @@ pub(super) fn track(
         .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
         .map_or(floor + 0.08 * height, |(i, _)| z_of(i));
 
+    // Armholes: through each armpit and its shoulder point, facing sideways.
+    let armhole = |pit: DVec3, sign: f64, name: &'static str| {
+        let shoulder = armhole::shoulder_point(body, sign, centre_x, pit, neck)
+            .ok_or(RegionError::NoArm { side: name })?;
+        Ok(Armhole::through(pit, shoulder, DVec3::NEG_Y, sign))
+    };
+    let left_armhole = armhole(left_pit, 1.0, "left")?;
+    let right_armhole = armhole(right_pit, -1.0, "right")?;
+
     let landmarks = Landmarks {
         height,
-        crotch: refine_crotch(
-            body,
-            z_of(crotch_i - 1),
-            z_of(crotch_i),
-            sections[crotch_i].loops[crotch_k].centroid(),
-        ),
+        crotch,
         ankle,
         left_armpit,
         right_armpit,
         neck,
         centre_x,
-        arm_cut: 0.5 * (left_side + right_side),
+        left_armhole,
+        right_armhole,
     };
 
     let levels = sections

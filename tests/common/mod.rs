@@ -196,3 +196,11 @@ pub fn synthetic_scan(dir: &std::path::Path, seed: u64) -> PathBuf {
     std::fs::write(&path, dressform::scan::format::Format::Ply.encode(&mesh)).expect("writable");
     path
 }
+
+/// A generated customer's surface as a mesh (in the canonical frame, as the generator makes it).
+pub fn mesh_of(body: &sim::capture::SyntheticBody) -> Mesh {
+    Mesh::new(
+        body.surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
+        body.surface.triangles.clone(),
+    )
+}

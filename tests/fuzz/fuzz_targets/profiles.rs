@@ -4,9 +4,12 @@
 
 use dressform::profiles::Profiles;
 use libfuzzer_sys::fuzz_target;
+use std::path::Path;
 
 fuzz_target!(|bytes: &[u8]| {
-    if let Ok(profiles) = Profiles::from_json(bytes) {
-        let _ = dressform::fitting::fit(&profiles, &sim::form::reference());
+    let form = sim::form::reference();
+    let regions = dressform::fitting::regions_of(&form);
+    if let Ok(profiles) = Profiles::parse(bytes, Path::new("fuzz.json"), &regions) {
+        let _ = dressform::fitting::fit(&profiles, &form);
     }
 });
