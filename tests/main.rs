@@ -21,6 +21,7 @@ mod fuzz_readers;
 mod makehuman;
 mod mannequin;
 mod measurements;
+mod outputs;
 mod run_end_to_end;
 mod segmentation;
 mod segmentation_stances;
