@@ -303,6 +303,7 @@ pub(super) fn encode(mesh: &Mesh, comments: &[String]) -> Vec<u8> {
         let positions_length = bin.len();
         bin.extend(mesh.triangles.iter().flatten().flat_map(|i| i.to_le_bytes()));
         let buffer = root.push(json::Buffer {
+            name: None,
             byte_length: USize64::from(bin.len()),
             extensions: None,
             extras: None,
@@ -310,6 +311,7 @@ pub(super) fn encode(mesh: &Mesh, comments: &[String]) -> Vec<u8> {
         });
         let view = |root: &mut json::Root, offset: usize, length: usize, target| {
             root.push(json::buffer::View {
+                name: None,
                 buffer,
                 byte_length: USize64::from(length),
                 byte_offset: Some(USize64::from(offset)),
@@ -333,6 +335,7 @@ pub(super) fn encode(mesh: &Mesh, comments: &[String]) -> Vec<u8> {
         };
         let accessor = |root: &mut json::Root, view, count, kind, type_, min, max| {
             root.push(json::Accessor {
+                name: None,
                 buffer_view: Some(view),
                 byte_offset: None,
                 count: USize64::from(count),
@@ -376,13 +379,19 @@ pub(super) fn encode(mesh: &Mesh, comments: &[String]) -> Vec<u8> {
             targets: None,
         };
         let mesh = root.push(json::Mesh {
+            name: None,
             extensions: None,
             extras: None,
             primitives: vec![primitive],
             weights: None,
         });
         let node = root.push(json::Node { mesh: Some(mesh), ..Default::default() });
-        let scene = root.push(json::Scene { extensions: None, extras: None, nodes: vec![node] });
+        let scene = root.push(json::Scene {
+            extensions: None,
+            extras: None,
+            name: None,
+            nodes: vec![node],
+        });
         root.scene = Some(scene);
     }
     // Serialising a document built above into memory cannot fail.
