@@ -20,6 +20,7 @@
 
 pub mod controller;
 pub mod fitting;
+pub mod input;
 pub mod makehuman;
 pub mod mannequin;
 pub mod measure;
