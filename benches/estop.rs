@@ -78,15 +78,7 @@ fn estop_latency(c: &mut Criterion) {
     for (name, transport, flag) in
         [("serial", Transport::SerialPty, "--serial"), ("slcan", Transport::SlcanPty, "--slcan")]
     {
-        let runtime = tokio::runtime::Builder::new_multi_thread()
-            .worker_threads(2)
-            .enable_all()
-            .build()
-            .expect("runtime");
-        let server = {
-            let _context = runtime.enter();
-            serve(ServeConfig::new(reference(), transport)).expect("the simulated form")
-        };
+        let server = serve(ServeConfig::new(reference(), transport)).expect("the simulated form");
         let mut latencies = Vec::new();
         group.bench_function(name, |b| {
             b.iter_custom(|iters| {

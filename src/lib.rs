@@ -23,6 +23,7 @@
 pub mod body_model;
 pub mod controller;
 pub mod fitting;
+pub mod input;
 pub mod makehuman;
 pub mod mannequin;
 pub mod measure;

@@ -28,12 +28,13 @@
 //! heights out of order within a region, negative or non-finite girths, and a region the
 //! form needs with fewer than two layers.
 
+use crate::input::{self, InputError};
 use crate::mannequin::{Layer, Mannequin};
 use crate::measure::Levels;
 use crate::regions::{Landmarks, Region};
 use crate::symmetry::Preserve;
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The format tag of this version.
 pub const FORMAT: &str = "dressform-profiles/1";
@@ -48,35 +49,6 @@ const MIN_LAYERS: usize = 2;
 
 /// The fewest points of a ring.
 const MIN_POINTS: usize = 3;
-
-/// Why a profiles file cannot be used.
-#[derive(Debug, thiserror::Error)]
-pub enum ProfilesError {
-    /// It cannot be read.
-    #[error("{}: cannot read: {source}", path.display())]
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// It is not a profiles file.
-    #[error("{}: not a profiles file: {message}", path.display())]
-    Syntax {
-        /// The file.
-        path: PathBuf,
-        /// What the JSON parser said.
-        message: String,
-    },
-    /// Its content cannot give set-points.
-    #[error("{}: {}", path.display(), problems.join("; "))]
-    Invalid {
-        /// The file.
-        path: PathBuf,
-        /// Every problem, each naming its field.
-        problems: Vec<String>,
-    },
-}
 
 /// The symmetric profiles of a mannequin.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -143,21 +115,15 @@ impl From<&Layer> for ProfileLayer {
 impl Profiles {
     /// Reads a profiles file and checks it ([`Profiles::validate`]) for a form that shapes
     /// `regions`.
-    pub fn load(path: &Path, regions: &[Region]) -> Result<Self, ProfilesError> {
-        let bytes = std::fs::read(path)
-            .map_err(|source| ProfilesError::Read { path: path.to_path_buf(), source })?;
-        Self::parse(&bytes, path, regions)
+    pub fn load(path: &Path, regions: &[Region]) -> Result<Self, InputError> {
+        Self::parse(&input::read(path)?, path, regions)
     }
 
-    /// Parses a profiles file's bytes (read from `path`, named in errors) and checks it
+    /// Parses the text of a profiles file (read from `path`, named in errors) and checks it
     /// ([`Profiles::validate`]) for a form that shapes `regions`.
-    pub fn parse(bytes: &[u8], path: &Path, regions: &[Region]) -> Result<Self, ProfilesError> {
-        let profiles: Profiles = serde_json::from_slice(bytes).map_err(|e| {
-            ProfilesError::Syntax { path: path.to_path_buf(), message: e.to_string() }
-        })?;
-        profiles
-            .validate(regions)
-            .map_err(|problems| ProfilesError::Invalid { path: path.to_path_buf(), problems })?;
+    pub fn parse(text: &str, path: &Path, regions: &[Region]) -> Result<Self, InputError> {
+        let profiles: Profiles = input::parse(text, path, "profiles")?;
+        input::check(path, profiles.validate(regions))?;
         Ok(profiles)
     }
 

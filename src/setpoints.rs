@@ -24,13 +24,14 @@
 //! (`--clamp`); only a [`Checked`] set of targets can be driven.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::de::{Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, Serialize};
 use sim::form::FormDescription;
 
 use crate::controller::safety::SafeTarget;
+use crate::input::{self, InputError};
 use crate::messages;
 use crate::output::{WriteError, write_atomically};
 
@@ -75,38 +76,6 @@ fn unique_keys<'de, D: Deserializer<'de>>(d: D) -> Result<BTreeMap<String, f64>,
     d.deserialize_map(Unique)
 }
 
-/// Why a set-point file cannot be used.
-#[derive(Debug, thiserror::Error)]
-pub enum SetPointsError {
-    /// It cannot be read.
-    #[error("{}: cannot read: {source}", path.display())]
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// It is not a set-point file.
-    #[error("{}: not a set-point file: {message}", path.display())]
-    Syntax {
-        /// The file.
-        path: PathBuf,
-        /// What the JSON parser said (with line and column).
-        message: String,
-    },
-    /// It is a set-point file, but not one for this form.
-    #[error("{}: {}", path.display(), summary(problems))]
-    Invalid {
-        /// The file.
-        path: PathBuf,
-        /// Every problem, each naming the field or the actuator.
-        problems: Vec<String>,
-    },
-    /// It cannot be written.
-    #[error(transparent)]
-    Write(#[from] WriteError),
-}
-
 /// Positions outside their actuator's stroke, refused.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("positions outside the stroke: {}", list(offending))]
@@ -120,19 +89,6 @@ fn list(offending: &[(String, f64, f64)]) -> String {
         let (id, asked, stroke) = (shown(id), messages::number(*asked), messages::number(*stroke));
         format!("{id} asks {asked} mm (stroke 0..={stroke} mm)")
     }))
-}
-
-/// How many problems a message lists.
-const PROBLEMS_SHOWN: usize = 3;
-
-/// `problems` for a message: all of a few, or how many and the first ones.
-fn summary(problems: &[String]) -> String {
-    let first = problems[..problems.len().min(PROBLEMS_SHOWN)].join("; ");
-    if problems.len() <= PROBLEMS_SHOWN {
-        first
-    } else {
-        format!("{} problems, the first {PROBLEMS_SHOWN}: {first}", problems.len())
-    }
 }
 
 /// An actuator id as messages show it (escaped, cut: ids come from files).
@@ -171,33 +127,20 @@ impl SetPoints {
 
     /// Parses set-point JSON; `path` names the source in errors. Checks the format and that
     /// every value is a finite number; [`SetPoints::validate`] checks it against a form.
-    pub fn from_json_str(text: &str, path: &Path) -> Result<Self, SetPointsError> {
-        let syntax = |e: serde_json::Error| SetPointsError::Syntax {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        };
+    pub fn from_json_str(text: &str, path: &Path) -> Result<Self, InputError> {
         // Non-finite numbers are not JSON; anything else wrong is named by serde.
-        let points: SetPoints = serde_json::from_str(text).map_err(syntax)?;
+        let points: SetPoints = input::parse(text, path, "set-point")?;
         if points.format != FORMAT {
-            return Err(SetPointsError::Invalid {
-                path: path.to_path_buf(),
-                problems: vec![format!(
-                    "format: expected \"{FORMAT}\", found \"{}\"",
-                    points.format
-                )],
-            });
+            let problem = format!("format: expected \"{FORMAT}\", found \"{}\"", points.format);
+            input::check(path, Err(vec![problem]))?;
         }
         Ok(points)
     }
 
     /// Reads and checks a set-point file against `form` (see [`SetPoints::validate`]).
-    pub fn load(path: &Path, form: &FormDescription) -> Result<Self, SetPointsError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| SetPointsError::Read { path: path.to_path_buf(), source })?;
-        let points = Self::from_json_str(&text, path)?;
-        points
-            .validate(form)
-            .map_err(|problems| SetPointsError::Invalid { path: path.to_path_buf(), problems })?;
+    pub fn load(path: &Path, form: &FormDescription) -> Result<Self, InputError> {
+        let points = Self::from_json_str(&input::read(path)?, path)?;
+        input::check(path, points.validate(form))?;
         Ok(points)
     }
 
@@ -236,8 +179,8 @@ impl SetPoints {
     }
 
     /// Writes the file atomically.
-    pub fn save(&self, path: &Path) -> Result<(), SetPointsError> {
-        Ok(write_atomically(path, self.to_json_string().as_bytes())?)
+    pub fn save(&self, path: &Path) -> Result<(), WriteError> {
+        write_atomically(path, self.to_json_string().as_bytes())
     }
 
     /// The targets on `form`: every position must lie in `[0, stroke]`, else the offenders

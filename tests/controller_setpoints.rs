@@ -2,7 +2,8 @@
 
 use std::collections::BTreeMap;
 
-use dressform::setpoints::{FORMAT, SetPoints, SetPointsError};
+use dressform::input::InputError;
+use dressform::setpoints::{FORMAT, SetPoints};
 use sim::form::reference;
 
 fn write(dir: &tempfile::TempDir, text: &str) -> std::path::PathBuf {
@@ -73,7 +74,7 @@ fn errors_name_the_file_and_the_problem() {
         assert!(error.contains("setpoints.json"), "{error}");
     }
     let missing = SetPoints::load(&dir.path().join("nope.json"), &form).unwrap_err();
-    assert!(matches!(missing, SetPointsError::Read { .. }), "{missing}");
+    assert!(matches!(missing, InputError::Read { .. }), "{missing}");
     // Non-finite values built in code are refused too.
     let nan = SetPoints::new("reference", BTreeMap::from([("chest-l1".to_string(), f64::NAN)]));
     assert!(nan.validate(&form).unwrap_err()[0].contains("not a finite number"));

@@ -28,12 +28,7 @@ fn scan_of(dir: &std::path::Path, params: &BodyParams) -> std::path::PathBuf {
 fn run_over(transport: Transport, flag: &str) {
     let tmp = tempfile::tempdir().unwrap();
     let scan = scan_file(tmp.path());
-    let runtime =
-        tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
-    let server = {
-        let _context = runtime.enter();
-        serve(ServeConfig::new(reference(), transport)).unwrap()
-    };
+    let server = serve(ServeConfig::new(reference(), transport)).unwrap();
     let out = tmp.path().join("out");
     let output = std::process::Command::new(env!("CARGO_BIN_EXE_dressform"))
         .args(["run", scan.to_str().unwrap(), flag, server.device_path().to_str().unwrap()])

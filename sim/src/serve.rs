@@ -19,16 +19,22 @@
 //! # Ok(()) }
 //! ```
 //!
-//! In async code, [`serve`] starts the form and returns a [`Server`];
-//! [`Server::run_until`] runs it until a future completes, then stops it and writes out the
-//! log.
+//! [`serve`] starts the form on a thread of its own and returns a [`Server`] (in async code,
+//! [`Server::run_until`] serves until a future completes); [`Server::shutdown`] stops it and
+//! writes out the log.
+//!
+//! **Its own thread.** The form runs on an OS thread of its own with a single-threaded tokio
+//! runtime, whoever calls [`serve`] (a test process busy with other tests, a host's runtime
+//! in the same process): nothing else runs there, so a loaded caller does not make a healthy
+//! simulated node answer late — as a node's own microcontroller is never held up by the host.
 
 use std::future::Future;
 use std::io;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::thread::JoinHandle;
 
 use tokio::sync::oneshot;
-use tokio::task::JoinHandle;
 
 use crate::bus::can::{BusStats, CanBus, CanKind};
 use crate::bus::candump::CandumpLog;
@@ -98,20 +104,27 @@ pub enum ServeError {
     },
 }
 
-/// A form being served.
+/// A form being served on its thread.
 #[derive(Debug)]
 pub struct Server {
     device: PathBuf,
-    log: Option<PathBuf>,
     // Declared first: the nodes stop before the bus.
     form: SimulatedForm,
-    /// The task moving the bytes (the serial line, or the slcan adapter); `None` once it has
-    /// been awaited.
-    task: Option<JoinHandle<Result<(), ServeError>>>,
-    /// Ends the serial line task (which then writes out its log).
+    /// The CAN bus behind the slcan adapter (for its counters).
+    bus: Option<Arc<CanBus>>,
+    /// Ends the form's thread (which then writes out the log); `None` once sent.
     stop: Option<oneshot::Sender<()>>,
-    /// The CAN bus behind the slcan adapter (it holds the log).
-    bus: Option<CanBus>,
+    /// Resolves (closed) when the form's thread ends, on `stop` or on a failure.
+    ended: oneshot::Receiver<()>,
+    /// The form's thread, with what it ends with; `None` once joined.
+    thread: Option<JoinHandle<Result<(), ServeError>>>,
+}
+
+/// What the form's thread hands back once the host can connect.
+struct Started {
+    device: PathBuf,
+    form: SimulatedForm,
+    bus: Option<Arc<CanBus>>,
 }
 
 fn log_error(path: &Option<PathBuf>) -> impl FnOnce(io::Error) -> ServeError + use<> {
@@ -119,20 +132,57 @@ fn log_error(path: &Option<PathBuf>) -> impl FnOnce(io::Error) -> ServeError + u
     move |source| ServeError::Log { path, source }
 }
 
-fn joined(
-    result: Result<Result<(), ServeError>, tokio::task::JoinError>,
-) -> Result<(), ServeError> {
-    result.unwrap_or_else(|e| Err(ServeError::Pty(io::Error::other(e))))
+/// How the form's thread ended.
+fn joined(thread: JoinHandle<Result<(), ServeError>>) -> Result<(), ServeError> {
+    thread
+        .join()
+        .unwrap_or_else(|_| Err(ServeError::Pty(io::Error::other("the simulator panicked"))))
 }
 
-/// Starts serving: opens the pty (and the log), powers the form on. Must be called within a
-/// tokio runtime; the form runs until the [`Server`] is stopped or dropped.
+/// Starts serving on a thread of its own: opens the pty (and the log), powers the form on.
+/// Callable from anywhere (within a tokio runtime or not); the form runs until the
+/// [`Server`] is stopped or dropped.
 pub fn serve(config: ServeConfig) -> Result<Server, ServeError> {
-    let ServeConfig { form, transport, log: log_path, faults, options } = config;
     // Refuse a bad form or fault spec before creating anything.
-    form.validate()
+    config
+        .form
+        .validate()
         .map_err(|problems| SimError::from(FormError::Invalid { path: None, problems }))?;
-    faults.check(&form).map_err(SimError::from)?;
+    config.faults.check(&config.form).map_err(SimError::from)?;
+    let (ready, started) = std::sync::mpsc::channel();
+    let (stop, stopped) = oneshot::channel();
+    let (ending, ended) = oneshot::channel::<()>();
+    let thread = std::thread::Builder::new()
+        .name("simulated form".into())
+        .spawn(move || {
+            // Dropped when the thread ends, whichever way: `ended` resolves.
+            let _ending = ending;
+            let runtime = tokio::runtime::Builder::new_current_thread()
+                .enable_all()
+                .build()
+                .map_err(ServeError::Runtime)?;
+            runtime.block_on(run_form(config, ready, stopped))
+        })
+        .map_err(ServeError::Runtime)?;
+    match started.recv() {
+        Ok(Started { device, form, bus }) => {
+            Ok(Server { device, form, bus, stop: Some(stop), ended, thread: Some(thread) })
+        }
+        // The thread ended before the form started: its error says why.
+        Err(_) => Err(joined(thread).err().unwrap_or_else(|| {
+            ServeError::Pty(io::Error::other("the simulator ended before it started"))
+        })),
+    }
+}
+
+/// The form's thread: starts the form, reports it through `ready`, serves until `stop` (or
+/// the pty fails), then writes out the log.
+async fn run_form(
+    config: ServeConfig,
+    ready: std::sync::mpsc::Sender<Started>,
+    stop: oneshot::Receiver<()>,
+) -> Result<(), ServeError> {
+    let ServeConfig { form, transport, log: log_path, faults, options } = config;
     let pty = Pty::open().map_err(ServeError::Pty)?;
     let device = pty.path().to_path_buf();
     let interface = match transport {
@@ -146,29 +196,30 @@ pub fn serve(config: ServeConfig) -> Result<Server, ServeError> {
         ),
         None => None,
     };
-    let server = match transport {
+    match transport {
         Transport::SerialPty => {
             let form = SimulatedForm::on_serial(&form, &faults, &options)?;
             let line = SerialLine::new(pty, DEFAULT_BAUD, &faults, log);
-            let (stop, stopped) = oneshot::channel();
-            let serving = form.serve_serial(line, options.tick, stopped);
-            let log_error = log_error(&log_path);
-            let task = tokio::spawn(async move {
-                let (line, log) = serving.await;
-                line.map_err(ServeError::Pty)?;
-                log.map_err(log_error)
-            });
-            Server { device, log: log_path, form, task: Some(task), stop: Some(stop), bus: None }
+            let serving = form.serve_serial(line, options.tick, stop);
+            // The caller went away: nothing to serve.
+            let Ok(()) = ready.send(Started { device, form, bus: None }) else { return Ok(()) };
+            let (line, log) = serving.await;
+            line.map_err(ServeError::Pty)?;
+            log.map_err(log_error(&log_path))
         }
         Transport::SlcanPty => {
-            let bus = CanBus::with(CanKind::CLASSIC_1M, &faults, log);
+            let bus = Arc::new(CanBus::with(CanKind::CLASSIC_1M, &faults, log));
             let form = SimulatedForm::on_can(&form, &bus, &faults, &options)?;
             let adapter = SlcanAdapter::new(pty, &bus);
-            let task = tokio::spawn(async move { adapter.run().await.map_err(ServeError::Pty) });
-            Server { device, log: log_path, form, task: Some(task), stop: None, bus: Some(bus) }
+            let started = Started { device, form, bus: Some(Arc::clone(&bus)) };
+            let Ok(()) = ready.send(started) else { return Ok(()) };
+            let result = tokio::select! {
+                result = adapter.run() => result.map_err(ServeError::Pty),
+                _ = stop => Ok(()),
+            };
+            result.and(bus.flush_log().map_err(log_error(&log_path)))
         }
-    };
-    Ok(server)
+    }
 }
 
 impl Server {
@@ -184,75 +235,54 @@ impl Server {
 
     /// The CAN bus's counters (slcan only).
     pub fn bus_stats(&self) -> Option<BusStats> {
-        self.bus.as_ref().map(CanBus::stats)
+        self.bus.as_deref().map(CanBus::stats)
     }
 
     /// Serves until `stop` completes (or the pty fails), then stops and writes out the log.
     pub async fn run_until(mut self, stop: impl Future<Output = ()>) -> Result<(), ServeError> {
-        let failed = match self.task.as_mut() {
-            Some(task) => tokio::select! {
-                result = task => Some(joined(result)),
-                () = stop => None,
-            },
-            None => None,
-        };
-        if failed.is_some() {
-            self.task = None;
+        tokio::select! {
+            _ = &mut self.ended => {}
+            () = stop => {}
         }
-        let stopped = self.shutdown().await;
-        failed.unwrap_or(Ok(())).and(stopped)
+        self.shutdown()
     }
 
-    /// Stops serving and writes out the log.
-    pub async fn shutdown(mut self) -> Result<(), ServeError> {
+    /// Stops serving and writes out the log; returns how serving ended. Blocks until the
+    /// form's thread has ended (at once, but for writing out the log).
+    pub fn shutdown(mut self) -> Result<(), ServeError> {
+        self.join()
+    }
+
+    fn join(&mut self) -> Result<(), ServeError> {
         if let Some(stop) = self.stop.take() {
-            // Gone if the task already ended.
+            // Gone if the thread already ended.
             let _ = stop.send(());
         }
-        let result = match self.task.take() {
-            // The serial line ends on `stop`; the slcan adapter would run on.
-            Some(task) if self.bus.is_none() || task.is_finished() => joined(task.await),
-            Some(task) => {
-                task.abort();
-                Ok(())
-            }
-            None => Ok(()),
-        };
-        let flushed = match &self.bus {
-            Some(bus) => bus.flush_log().map_err(log_error(&self.log)),
-            None => Ok(()),
-        };
-        result.and(flushed)
+        self.thread.take().map_or(Ok(()), joined)
     }
 }
 
 impl Drop for Server {
-    /// Stops serving (the log is written out as far as it can be, errors unreported; use
-    /// [`Server::shutdown`] to see them).
+    /// Stops serving (the log is written out, errors unreported; use [`Server::shutdown`] to
+    /// see them).
     fn drop(&mut self) {
-        if let Some(task) = &self.task {
-            task.abort();
-        }
+        let _ = self.join();
     }
 }
 
-/// Serves `config` until Ctrl-C, on a runtime of its own; `ready` gets the device path
-/// once the host can connect. What `dressform sim` calls.
+/// Serves `config` until Ctrl-C; `ready` gets the device path once the host can connect.
+/// What `dressform sim` calls.
 pub fn run_until_ctrl_c(config: ServeConfig, ready: impl FnOnce(&Path)) -> Result<(), ServeError> {
+    let server = serve(config)?;
+    ready(server.device_path());
     let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
         .map_err(ServeError::Runtime)?;
-    runtime.block_on(async {
-        let server = serve(config)?;
-        ready(server.device_path());
-        server
-            .run_until(async {
-                // Without a signal handler there is nothing to wait for but the pty failing.
-                if tokio::signal::ctrl_c().await.is_err() {
-                    std::future::pending::<()>().await;
-                }
-            })
-            .await
-    })
+    runtime.block_on(server.run_until(async {
+        // Without a signal handler there is nothing to wait for but the pty failing.
+        if tokio::signal::ctrl_c().await.is_err() {
+            std::future::pending::<()>().await;
+        }
+    }))
 }

@@ -13,19 +13,7 @@ use firmware_protocol::{
 };
 use serialport::SerialPort;
 use sim::form::reference;
-use sim::serve::{ServeConfig, Server, Transport, serve};
-use tokio::runtime::Runtime;
-
-/// The form served on a runtime of its own (the test thread is the blocking host).
-fn start(config: ServeConfig) -> (Runtime, Server) {
-    let runtime =
-        tokio::runtime::Builder::new_multi_thread().worker_threads(1).enable_all().build().unwrap();
-    let server = {
-        let _context = runtime.enter();
-        serve(config).unwrap()
-    };
-    (runtime, server)
-}
+use sim::serve::{ServeConfig, Transport, serve};
 
 /// A blocking serial host.
 struct Host {
@@ -80,7 +68,7 @@ impl Host {
 #[test]
 fn a_host_on_the_pty_identifies_every_node() {
     let description = reference();
-    let (_runtime, server) = start(ServeConfig::new(description.clone(), Transport::SerialPty));
+    let server = serve(ServeConfig::new(description.clone(), Transport::SerialPty)).unwrap();
     assert!(server.device_path().starts_with("/dev/pts"), "{:?}", server.device_path());
     let mut host = Host::open(server.device_path());
     for node in description.node_ids() {
@@ -106,7 +94,7 @@ fn a_host_on_the_pty_identifies_every_node() {
 
 #[test]
 fn garbage_on_the_line_is_skipped() {
-    let (_runtime, server) = start(ServeConfig::new(reference(), Transport::SerialPty));
+    let server = serve(ServeConfig::new(reference(), Transport::SerialPty)).unwrap();
     let mut host = Host::open(server.device_path());
     let garbage: Vec<u8> =
         (0..400u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8).collect();
@@ -124,7 +112,7 @@ fn garbage_on_the_line_is_skipped() {
 #[test]
 fn a_host_enables_homes_and_moves_a_node_over_the_pty() {
     let description = reference();
-    let (_runtime, server) = start(ServeConfig::new(description.clone(), Transport::SerialPty));
+    let server = serve(ServeConfig::new(description.clone(), Transport::SerialPty)).unwrap();
     let mut host = Host::open(server.device_path());
     let node = NodeId::new(7).unwrap();
     let ack = |request, status| Packet::node(node, Message::Ack(Ack { request, status }));
@@ -179,11 +167,11 @@ fn the_serial_log_records_requests_and_answers() {
     let log = dir.path().join("serial.log");
     let mut config = ServeConfig::new(reference(), Transport::SerialPty);
     config.log = Some(log.clone());
-    let (runtime, server) = start(config);
+    let server = serve(config).unwrap();
     let mut host = Host::open(server.device_path());
     let node = NodeId::new(2).unwrap();
     assert_eq!(host.request(Packet::node(node, Message::IdentifyRequest), 2).len(), 2);
-    runtime.block_on(server.shutdown()).unwrap();
+    server.shutdown().unwrap();
     let text = std::fs::read_to_string(&log).unwrap();
     let frames: Vec<&str> = text.lines().map(|l| l.split(' ').nth(2).unwrap()).collect();
     // IdentifyRequest to node 2, then its Identity and Capabilities (CAN ids of the packets).

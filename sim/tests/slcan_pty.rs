@@ -11,16 +11,10 @@ use firmware_protocol::{Code, Message, can};
 use serialport::SerialPort;
 use sim::form::reference;
 use sim::serve::{ServeConfig, Server, Transport, serve};
-use tokio::runtime::Runtime;
 
-fn start() -> (Runtime, Server) {
-    let runtime =
-        tokio::runtime::Builder::new_multi_thread().worker_threads(1).enable_all().build().unwrap();
-    let server = {
-        let _context = runtime.enter();
-        serve(ServeConfig::new(reference(), Transport::SlcanPty)).unwrap()
-    };
-    (runtime, server)
+/// The reference form behind an slcan adapter.
+fn start() -> Server {
+    serve(ServeConfig::new(reference(), Transport::SlcanPty)).unwrap()
 }
 
 fn open(server: &Server) -> Box<dyn SerialPort> {
@@ -70,7 +64,7 @@ fn parse(line: &str) -> Option<Frame> {
 
 #[test]
 fn an_slcan_host_identifies_every_node() {
-    let (_runtime, server) = start();
+    let server = start();
     let mut port = open(&server);
     port.write_all(b"C\rS8\rO\r").unwrap();
     assert_eq!(read_answers(&mut port, 3), ["\r", "\r", "\r"]);
@@ -108,7 +102,7 @@ fn an_slcan_host_identifies_every_node() {
 
 #[test]
 fn the_adapter_refuses_what_a_classic_slcan_adapter_cannot_do() {
-    let (_runtime, server) = start();
+    let server = start();
     let mut port = open(&server);
     // A wrong bit rate cannot reach the bus, so the channel does not open.
     port.write_all(b"S6\rO\r").unwrap();

@@ -55,19 +55,14 @@ fn python_can_identifies_every_node_over_slcan_and_reads_the_log() {
     let nodes = description.nodes.len().to_string();
     let mut config = ServeConfig::new(description, Transport::SlcanPty);
     config.log = Some(log.clone());
-    let runtime =
-        tokio::runtime::Builder::new_multi_thread().worker_threads(1).enable_all().build().unwrap();
-    let server = {
-        let _context = runtime.enter();
-        serve(config).unwrap()
-    };
+    let server = serve(config).unwrap();
     let device = server.device_path().to_str().unwrap().to_string();
 
     let identified = peer(&["identify", &device, &nodes]);
     let summary = String::from_utf8_lossy(&identified.stdout);
     assert!(summary.starts_with("identified nodes=8 strokes=[2500, 6000"), "{summary}");
 
-    runtime.block_on(server.shutdown()).unwrap();
+    server.shutdown().unwrap();
     let lines = std::fs::read_to_string(&log).unwrap().lines().count();
     let read = peer(&["read-log", log.to_str().unwrap(), &nodes]);
     let summary = String::from_utf8_lossy(&read.stdout);

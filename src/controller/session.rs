@@ -12,10 +12,13 @@
 //!   waits for an answer (so a long series of requests never starves a node's watchdog);
 //! * requests (`IdentifyRequest`, `Control`, `Home`) are addressed and sent up to
 //!   [`ATTEMPTS`] times on no answer; an `Ack` other than Ok is an error naming the node;
-//! * a node not heard for [`NODE_LOST_AFTER`] (three heartbeat periods) of *listening time*
-//!   is lost: silence counts only while the host's receive loop actually runs
-//!   ([`ListeningClock`]), so a host descheduled by a busy machine does not blame healthy
-//!   nodes for its own stall, and received packets are always taken before silence is judged;
+//! * a node that misses three heartbeats in a row is lost. On CAN, where nodes send them
+//!   unasked, that is [`NODE_LOST_AFTER`] of *listening time*: silence counts only while the
+//!   host's receive loop actually runs ([`ListeningClock`]), so a host descheduled by a busy
+//!   machine does not blame healthy nodes for its own stall. On serial, where the poll is the
+//!   heartbeat, it is [`POLLS_LOST`] polls in a row unanswered: a host that polls slowly (busy,
+//!   or behind a slow adapter) does not make a node that answers every poll silent. Received
+//!   packets are always taken before silence is judged;
 //! * a node whose heartbeat falls back to Disabled unasked (or forgets its homes) has
 //!   rebooted.
 //!
@@ -56,6 +59,9 @@ pub const HEARTBEAT_PERIOD: Duration =
 pub const POLL_PERIOD: Duration = Duration::from_millis(timing::FEEDBACK_PERIOD_MS as u64);
 /// A node not heard for this long is lost (three heartbeat periods).
 pub const NODE_LOST_AFTER: Duration = Duration::from_millis(timing::NODE_LOST_AFTER_MS as u64);
+/// A serial node that leaves this many polls in a row unanswered is lost: the poll is its
+/// heartbeat, and [`NODE_LOST_AFTER`] is this many heartbeat periods.
+pub const POLLS_LOST: u32 = (timing::NODE_LOST_AFTER_MS / timing::HEARTBEAT_PERIOD_MS) as u32;
 /// The longest a gap between two wakes of the receive loop counts towards a node's silence:
 /// the loop wakes at least every answer timeout (60 ms on serial), so a longer gap is the
 /// host's own stall (one heartbeat period allows for a busy machine).
@@ -102,6 +108,8 @@ pub struct NodeStatus {
     pub positions: [Option<Position>; MAX_ACTUATORS],
     /// When it was last heard from, in the session's listening time.
     pub heard: Option<Duration>,
+    /// Polls in a row it left unanswered (serial), since it was last heard from.
+    pub unanswered_polls: u32,
     /// Its `Emergency` events not yet handled, oldest first.
     pub events: Vec<Emergency>,
     /// It fell back to Disabled with its homes forgotten since this was last cleared.
@@ -172,9 +180,17 @@ pub enum SessionError {
         /// How many times it was sent.
         attempts: u8,
     },
-    /// A node went silent.
+    /// A node went silent (CAN: no heartbeat for [`NODE_LOST_AFTER`] of listening time).
     #[error("node {node}: lost: nothing heard for {} ms (limit {} ms)", silent.as_millis(), NODE_LOST_AFTER.as_millis())]
     NodeLost {
+        /// The node.
+        node: u8,
+        /// How long it had been silent when noticed.
+        silent: Duration,
+    },
+    /// A serial node left [`POLLS_LOST`] polls in a row unanswered.
+    #[error("node {node}: lost: {POLLS_LOST} polls in a row unanswered (nothing heard for {} ms)", silent.as_millis())]
+    NodeUnanswered {
         /// The node.
         node: u8,
         /// How long it had been silent when noticed.
@@ -339,6 +355,7 @@ impl<T: Transport> Session<T> {
             return;
         };
         status.heard = Some(self.clock.tick());
+        status.unanswered_polls = 0;
         match packet.message {
             Message::Heartbeat(h) => {
                 // Back to Disabled without being told (only Disable does that), or homes
@@ -461,10 +478,16 @@ impl<T: Transport> Session<T> {
                 // A lost poll is noticed by liveness, not retried.
                 let deadline = Instant::now() + answer_timeout(Link::Serial);
                 self.send(Packet::node(node, heartbeat)).await?;
-                self.receive_until(deadline, |p| {
-                    p.address == Address::Node(node) && matches!(p.message, Message::AllFeedback(_))
-                })
-                .await?;
+                let answer = self
+                    .receive_until(deadline, |p| {
+                        p.address == Address::Node(node)
+                            && matches!(p.message, Message::AllFeedback(_))
+                    })
+                    .await?;
+                if let (None, Some(status)) = (answer, self.nodes.get_mut(&node)) {
+                    // Any packet from the node starts the count again (see `handle`).
+                    status.unanswered_polls += 1;
+                }
             }
         } else {
             self.next_service = now + HEARTBEAT_PERIOD;
@@ -474,12 +497,21 @@ impl<T: Transport> Session<T> {
         Ok(())
     }
 
-    /// The first node not heard for [`NODE_LOST_AFTER`] of listening time.
-    fn lost(&mut self) -> Option<(NodeId, Duration)> {
+    /// The first node lost (see the module docs): on serial, one that left [`POLLS_LOST`]
+    /// polls in a row unanswered; on CAN, one not heard for [`NODE_LOST_AFTER`] of listening
+    /// time.
+    fn lost(&mut self) -> Option<SessionError> {
         let now = self.clock.tick();
+        let serial = self.link() == Link::Serial;
         self.nodes.iter().find_map(|(&node, status)| {
             let silent = now.saturating_sub(status.heard?);
-            (silent > NODE_LOST_AFTER).then_some((node, silent))
+            let node = node.get();
+            if serial {
+                (status.unanswered_polls >= POLLS_LOST)
+                    .then_some(SessionError::NodeUnanswered { node, silent })
+            } else {
+                (silent > NODE_LOST_AFTER).then_some(SessionError::NodeLost { node, silent })
+            }
         })
     }
 
@@ -494,9 +526,9 @@ impl<T: Transport> Session<T> {
         loop {
             self.service().await?;
             if self.watch_liveness
-                && let Some((node, silent)) = self.lost()
+                && let Some(lost) = self.lost()
             {
-                return Err(SessionError::NodeLost { node: node.get(), silent });
+                return Err(lost);
             }
             if done(self) {
                 return Ok(true);
@@ -718,13 +750,18 @@ impl<T: Transport> Session<T> {
         })
     }
 
-    /// Waits (up to [`NODE_LOST_AFTER`]) for a heartbeat from every node sent after now: on
-    /// serial, nodes speak only when polled, so what is known may be from before.
+    /// Waits for a heartbeat from every node sent after now (on serial, nodes speak only when
+    /// polled, so what is known may be from before): up to [`NODE_LOST_AFTER`] on CAN, and on
+    /// serial up to one poll of every node with every answer late.
     pub async fn refresh(&mut self) -> Result<(), SessionError> {
         let since = Instant::now();
         self.next_service = since;
+        let patience = match self.link() {
+            Link::Serial => answer_timeout(Link::Serial) * self.nodes.len() as u32,
+            _ => NODE_LOST_AFTER,
+        };
         let fresh = |s: &Self| s.nodes.values().all(|n| n.heartbeat_at.is_some_and(|t| t > since));
-        self.wait_until(since + NODE_LOST_AFTER, fresh).await?;
+        self.wait_until(since + patience.max(NODE_LOST_AFTER), fresh).await?;
         Ok(())
     }
 

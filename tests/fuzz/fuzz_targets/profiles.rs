@@ -9,7 +9,8 @@ use std::path::Path;
 fuzz_target!(|bytes: &[u8]| {
     let form = sim::form::reference();
     let regions = dressform::fitting::regions_of(&form);
-    if let Ok(profiles) = Profiles::parse(bytes, Path::new("fuzz.json"), &regions) {
+    let Ok(text) = std::str::from_utf8(bytes) else { return };
+    if let Ok(profiles) = Profiles::parse(text, Path::new("fuzz.json"), &regions) {
         let _ = dressform::fitting::fit(&profiles, &form);
     }
 });
