@@ -22,6 +22,7 @@ mod mannequin;
 mod measurements;
 mod run_end_to_end;
 mod segmentation;
+mod segmentation_makehuman;
 mod segmentation_stances;
 mod sim_cli;
 mod synthetic_bodies;
