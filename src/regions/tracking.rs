@@ -237,12 +237,15 @@ pub(super) fn track(
             let torso_here = &sections[i].loops[t];
             let centre = bbox_centre_x(torso_here);
             let next = &sections[j].loops[t_next];
-            let joined = (0..sections[i].loops.len())
+            let mut beside = (0..sections[i].loops.len())
                 .filter(|&k| k != t)
-                .filter(|&k| sign * (sections[i].loops[k].centroid().x - centre) > 0.0)
-                .find(|&k| overlaps(&sections[i].loops[k], next))
-                .map(Join::Loop);
-            let grown = reach(next, sign, centre) - reach(torso_here, sign, centre) > ARM_JUMP_MM;
+                .filter(|&k| sign * (sections[i].loops[k].centroid().x - centre) > 0.0);
+            let arm_loop_here = beside.clone().next().is_some();
+            let joined = beside.find(|&k| overlaps(&sections[i].loops[k], next)).map(Join::Loop);
+            // An arm whose own loop is still beside the torso joins as that loop (its blend may
+            // widen the torso's loop first); only an arm with none below grows out.
+            let grown = !arm_loop_here
+                && reach(next, sign, centre) - reach(torso_here, sign, centre) > ARM_JUMP_MM;
             joined.or(grown.then_some(Join::Outgrowth)).map(|how| (i, t, how))
         })
     };
