@@ -24,6 +24,7 @@ mod measurements;
 mod outputs;
 mod run_end_to_end;
 mod segmentation;
+mod segmentation_makehuman;
 mod segmentation_stances;
 mod sim_cli;
 mod synthetic_bodies;

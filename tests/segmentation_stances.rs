@@ -183,24 +183,28 @@ fn a_pose() {
 }
 
 #[test]
-#[ignore = "not yet: girths hold (worst -0.86 mm) and all 20 segment, but an elbow resting on \
-            the torso between the girth levels (seed 12, z = 1111) leaves 8.4 mm of arm in the \
-            torso loop: touching loops are not split yet"]
+#[ignore = "not yet: all 20 segment, girths hold (worst -0.86 mm), armpits within 0.1 mm of \
+            the truth; but 0.3 mm below the true armpit (seed 12, z = 1111.0) the torso loop's \
+            blend into the arm lies 8.4 mm outside the armless body (allowed: 6.5)"]
 fn slightly_asymmetric() {
     run_stance(Stance::SlightlyAsymmetric);
 }
 
 #[test]
-#[ignore = "not yet: girths hold (worst -0.32 mm), but where the raised arm grows straight out \
-            of the torso with no separate underside loop, the armpit is taken where the hand \
-            joins (seed 0: 765 mm out), so the arm is not cut off above it"]
+#[ignore = "not yet: all 20 segment, girths hold (worst -0.33 mm), the held-out arm's armpit \
+            is its crease (seed 0: was 765 mm out at the hand, now at the torso); but 0.4 mm \
+            below the other, hanging arm's true armpit (seed 16, z = 1162.3) the torso loop's \
+            blend lies 8.4 mm outside the armless body (allowed: 6.5)"]
 fn one_arm_horizontal() {
     run_stance(Stance::OneArmHorizontal);
 }
 
 #[test]
-#[ignore = "not yet: all 20 segment, but the contact is taken for the armpit, so the chest is \
-            looked for below it (worst -11.4 mm) and the merged loops are not split"]
+#[ignore = "not yet: all 20 segment and girths hold (worst +0.94 mm), but where the resting \
+            arm touches the torso in front of or behind the shoulder's frontal plane its loop \
+            merges 17 mm below the top of the gap (seed 15: 1354 against 1371 mm), so the arm \
+            plate is tilted and leaves 24 mm of arm beyond the true plate at z = 1370 \
+            (allowed: 15): touching loops are not split yet"]
 fn an_arm_resting_on_the_torso() {
     run_stance(Stance::ArmResting);
 }

@@ -3,8 +3,8 @@
 //! Every girth is horizontal and taken on the torso's loop; the tape girth is the convex
 //! hull's perimeter. Levels are found on the input body (canonical frame, mm):
 //! - **chest**: the largest torso tape girth from 10% of the height below the lower armpit up
-//!   to 1% below it (bust/chest: maximum girth just below the armpits; above the lower armpit
-//!   a raised arm would join the loop);
+//!   to [`CHEST_BELOW_ARMPIT_MM`] below it (bust/chest: maximum girth just below the armpits;
+//!   above the lower armpit a raised arm would join the loop);
 //! - **hip**: where the buttocks protrude most (the torso's greatest +Y, i.e. backward, extent)
 //!   between the crotch and 35% of the way up to the armpits; where they protrude within 1 mm of
 //!   that over a range of levels (a flat seat), the middle of that range;
@@ -33,6 +33,11 @@ use serde::Serialize;
 
 /// Sampling step when searching for measurement levels (mm).
 const LEVEL_STEP_MM: f64 = 2.0;
+/// How far below the lower armpit the chest may be (mm): one sampling step, so that the
+/// level where the arm joins is never taken. An arm lowered to rest on the torso brings its
+/// armpit down to within a few millimetres of the bust point (3 mm on the generator's
+/// customers), so a margin of 1% of the stature (17 mm) missed the chest there.
+const CHEST_BELOW_ARMPIT_MM: f64 = LEVEL_STEP_MM;
 
 /// A horizontal girth.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -103,8 +108,9 @@ pub fn levels(body: &Mesh, regions: &BodyRegions) -> Levels {
             .map(|&(z, c)| (z, score(c)))
             .max_by(|a, b| a.1.total_cmp(&b.1))
     };
-    let chest = best((armpit - 0.10 * m.height, armpit - 0.01 * m.height), &|c| c.tape_girth())
-        .map_or(armpit - 0.05 * m.height, |b| b.0);
+    let chest =
+        best((armpit - 0.10 * m.height, armpit - CHEST_BELOW_ARMPIT_MM), &|c| c.tape_girth())
+            .map_or(armpit - 0.05 * m.height, |b| b.0);
     let hip_band = (m.crotch, m.crotch + 0.35 * (armpit - m.crotch));
     let back = |c: &Contour| c.points.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max);
     let hip = match best(hip_band, &back) {

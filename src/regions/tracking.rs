@@ -41,14 +41,20 @@ fn x_range(c: &Contour) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)))
 }
 
+/// The part of `body` between the heights `below` and `above`: all a bisection between two
+/// tracking levels needs to cut.
+fn between(body: &Mesh, below: f64, above: f64) -> Mesh {
+    body.part(|tri| {
+        let z = tri.map(|v| body.positions[v as usize].z);
+        z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
+    })
+}
+
 /// The crotch between `below` (the legs apart, their loops around `legs`) and `above` (one
 /// loop around both), by bisection to 0.1 mm, cutting only the part of the body between the
 /// two heights.
 fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, legs: [DVec2; 2]) -> f64 {
-    let near = body.part(|tri| {
-        let z = tri.map(|v| body.positions[v as usize].z);
-        z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
-    });
+    let near = between(body, below, above);
     while above - below > 0.1 {
         let mid = 0.5 * (below + above);
         let s = &sections(&near, &[mid])[0];
@@ -74,10 +80,7 @@ fn refine_armpit(
     arm: &Contour,
     torso: &Contour,
 ) -> DVec3 {
-    let near = body.part(|tri| {
-        let z = tri.map(|v| body.positions[v as usize].z);
-        z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
-    });
+    let near = between(body, below, above);
     let torso_c = torso.centroid();
     let mut apart = (arm.clone(), torso.clone());
     while above - below > 0.1 {
@@ -95,6 +98,57 @@ fn refine_armpit(
     }
     let (p, q) = armhole::closest_points(&apart.0, &apart.1);
     (0.5 * (p + q)).extend(above)
+}
+
+/// How an arm joins the torso's loop going up.
+#[derive(Debug, Clone, Copy)]
+enum Join {
+    /// The arm's own loop (this index, on the level below) merges into the torso's.
+    Loop(usize),
+    /// The torso's loop grows out sideways with no separate loop below: an arm held out.
+    Outgrowth,
+}
+
+/// How much further a torso loop may reach sideways from one tracking level to the next
+/// before an arm must have joined it (mm): the torso's side below the armpits widens by a few
+/// millimetres per 5 mm level at most (its wall is far steeper than 3 in 1), while an arm
+/// held out adds its whole length.
+const ARM_JUMP_MM: f64 = 15.0;
+
+/// How far loop `c` reaches to the side `sign` (+1 the subject's left, +X) of `centre` (mm).
+fn reach(c: &Contour, sign: f64, centre: f64) -> f64 {
+    c.points.iter().map(|p| sign * (p.x - centre)).fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// The armpit of an arm that grows straight out of the torso's loop between `below` (the
+/// torso's loop `torso` there, not yet joined) and `above`, by bisection to 0.1 mm: the
+/// torso's outermost point on side `sign` at the highest level where its reach has not yet
+/// jumped by [`ARM_JUMP_MM`] — the crease under the arm.
+fn refine_outgrowth(
+    body: &Mesh,
+    mut below: f64,
+    mut above: f64,
+    torso: &Contour,
+    sign: f64,
+) -> DVec3 {
+    let near = between(body, below, above);
+    let (torso_c, centre) = (torso.centroid(), bbox_centre_x(torso));
+    let limit = reach(torso, sign, centre) + ARM_JUMP_MM;
+    let mut apart = torso.clone();
+    while above - below > 0.1 {
+        let mid = 0.5 * (below + above);
+        let s = &sections(&near, &[mid])[0];
+        match loop_containing(s, torso_c).map(|t| &s.loops[t]) {
+            Some(t) if reach(t, sign, centre) <= limit => {
+                apart = t.clone();
+                below = mid;
+            }
+            _ => above = mid,
+        }
+    }
+    let side = |p: &&DVec2| sign * (p.x - centre);
+    let outermost = apart.points.iter().max_by(|a, b| side(a).total_cmp(&side(b)));
+    outermost.copied().unwrap_or(torso_c).extend(above)
 }
 
 /// Whether loop `a` overlaps loop `b` seen from above: a point of `a` lies inside `b`.
@@ -172,18 +226,27 @@ pub(super) fn track(
         torso[i] = Some(k);
     }
 
-    // Armpits: going up from the seed, the first level where a loop beside the torso on that
-    // side joins it (a hanging arm at once, a raised arm's underside as a thin sliver).
+    // Armpits: going up from the seed, the first level where the torso's loop takes in an arm
+    // on that side: a loop beside it joins it (a hanging or A-posed arm at once, a raised
+    // arm's underside as a thin sliver), or the loop reaches out at once much further than the
+    // torso's side could (an arm held out horizontally grows straight out of it, with no
+    // separate loop below).
     let joining = |sign: f64| {
         up.windows(2).find_map(|w| {
-            let ((i, t), (_, t_next)) = (w[0], w[1]);
-            let centre = bbox_centre_x(&sections[i].loops[t]);
-            let next = &sections[w[1].0].loops[t_next];
-            (0..sections[i].loops.len())
+            let ((i, t), (j, t_next)) = (w[0], w[1]);
+            let torso_here = &sections[i].loops[t];
+            let centre = bbox_centre_x(torso_here);
+            let next = &sections[j].loops[t_next];
+            let mut beside = (0..sections[i].loops.len())
                 .filter(|&k| k != t)
-                .filter(|&k| sign * (sections[i].loops[k].centroid().x - centre) > 0.0)
-                .find(|&k| overlaps(&sections[i].loops[k], next))
-                .map(|k| (i, t, k))
+                .filter(|&k| sign * (sections[i].loops[k].centroid().x - centre) > 0.0);
+            let arm_loop_here = beside.clone().next().is_some();
+            let joined = beside.find(|&k| overlaps(&sections[i].loops[k], next)).map(Join::Loop);
+            // An arm whose own loop is still beside the torso joins as that loop (its blend may
+            // widen the torso's loop first); only an arm with none below grows out.
+            let grown = !arm_loop_here
+                && reach(next, sign, centre) - reach(torso_here, sign, centre) > ARM_JUMP_MM;
+            joined.or(grown.then_some(Join::Outgrowth)).map(|how| (i, t, how))
         })
     };
     let (Some(left), Some(right)) = (joining(1.0), joining(-1.0)) else {
@@ -193,11 +256,16 @@ pub(super) fn track(
     // The centre line: the torso's bounding-box centre just below the lower armpit.
     let (i, t, _) = if left.0 <= right.0 { left } else { right };
     let centre_x = bbox_centre_x(&sections[i].loops[t]);
-    let armpit_point = |(i, t, k): (usize, usize, usize)| {
-        let (arm, torso_loop) = (&sections[i].loops[k], &sections[i].loops[t]);
-        refine_armpit(body, z_of(i), z_of(i + 1), arm, torso_loop)
+    let armpit_point = |(i, t, how): (usize, usize, Join), sign: f64| {
+        let torso_loop = &sections[i].loops[t];
+        match how {
+            Join::Loop(k) => {
+                refine_armpit(body, z_of(i), z_of(i + 1), &sections[i].loops[k], torso_loop)
+            }
+            Join::Outgrowth => refine_outgrowth(body, z_of(i), z_of(i + 1), torso_loop, sign),
+        }
     };
-    let (left_pit, right_pit) = (armpit_point(left), armpit_point(right));
+    let (left_pit, right_pit) = (armpit_point(left, 1.0), armpit_point(right, -1.0));
     let (left_armpit, right_armpit) = (left_pit.z, right_pit.z);
 
     // Neck: the narrowest torso level between the armpits and the head's widest level.

@@ -114,8 +114,6 @@ impl Artifacts {
 /// holes the vertices keep their order and count; with holes the unused vertices are dropped
 /// (the others keep their relative order). Deterministic for a given seed.
 pub fn capture(body: &SyntheticBody, artifacts: &Artifacts) -> TriangleSurface {
-    let mut surface = body.surface.clone();
-    add_noise(&mut surface, artifacts.noise_sigma_mm, artifacts.seed);
     let mut sites = Vec::new();
     for site in &artifacts.holes {
         let lm = &body.truth.landmarks;
@@ -125,10 +123,13 @@ pub fn capture(body: &SyntheticBody, artifacts: &Artifacts) -> TriangleSurface {
             HoleSite::Soles => sites.extend([lm.left.sole_centre, lm.right.sole_centre]),
         }
     }
-    let radius = artifacts.hole_radius_mm;
-    if !sites.is_empty() && radius.is_finite() && radius > 0.0 {
-        surface = cut_holes(&surface, &sites, radius);
-    }
+    let mut surface = with_noise_and_holes(
+        &body.surface,
+        artifacts.noise_sigma_mm,
+        &sites,
+        artifacts.hole_radius_mm,
+        artifacts.seed,
+    );
     let (sin, cos) = artifacts.yaw_deg.to_radians().sin_cos();
     let turn = artifacts.yaw_deg.is_finite() && artifacts.yaw_deg != 0.0;
     let scale = artifacts.units.mm_per_unit();
@@ -142,6 +143,25 @@ pub fn capture(body: &SyntheticBody, artifacts: &Artifacts) -> TriangleSurface {
             UpAxis::Y => [x, z, -y],
         };
         *p = q.map(|v| v / scale);
+    }
+    surface
+}
+
+/// A scanner's noise and holes on any surface (mm): each vertex moved along its normal by a
+/// Gaussian amount of deviation `noise_sigma_mm` (from `seed`), then the triangles within
+/// `hole_radius_mm` of any of `sites` removed (as [`capture`] does at the armpits, crotch and
+/// soles); a zero, negative or non-finite deviation or radius means none.
+pub fn with_noise_and_holes(
+    surface: &TriangleSurface,
+    noise_sigma_mm: f64,
+    sites: &[[f64; 3]],
+    hole_radius_mm: f64,
+    seed: u64,
+) -> TriangleSurface {
+    let mut surface = surface.clone();
+    add_noise(&mut surface, noise_sigma_mm, seed);
+    if !sites.is_empty() && hole_radius_mm.is_finite() && hole_radius_mm > 0.0 {
+        surface = cut_holes(&surface, sites, hole_radius_mm);
     }
     surface
 }

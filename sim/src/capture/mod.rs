@@ -35,7 +35,7 @@ mod torso;
 mod truth;
 mod warp;
 
-pub use artifacts::{Artifacts, HoleSite, Units, UpAxis, capture};
+pub use artifacts::{Artifacts, HoleSite, Units, UpAxis, capture, with_noise_and_holes};
 pub use params::{
     ArmPose, BodyParams, DEFAULT_RESOLUTION_MM, LegPose, ParamError, Pose, SpinePose,
 };
