@@ -17,6 +17,7 @@ mod fitting;
 mod formats;
 mod fuzz_readers;
 mod mannequin;
+mod mannequin_quality;
 mod run_end_to_end;
 mod sim_cli;
 mod synthetic_bodies;

@@ -125,7 +125,7 @@ pub fn build(
     crate::symmetry::check_rays(options.rays)?;
     let layers::SymmetricLayers { axis, torso, left_leg, right_leg } =
         layers::symmetric_layers(body, regions, keep, options)?;
-    let mesh = rebuild::rebuild(&torso, &left_leg, &right_leg, axis);
+    let mesh = rebuild::rebuild(&torso, &left_leg, &right_leg, axis, regions.landmarks.crotch);
     Ok(Mannequin {
         axis,
         landmarks: regions.landmarks,

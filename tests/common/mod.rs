@@ -3,6 +3,8 @@
 
 use std::path::PathBuf;
 
+pub mod quality;
+
 /// Whether the environment variable `var` is set to `1` (CI sets `DRESSFORM_REQUIRE_SHARED` and
 /// `DRESSFORM_REQUIRE_PEERS`).
 fn required(var: &str) -> bool {
@@ -60,7 +62,8 @@ pub fn validate_gltf(file: &std::path::Path) -> Option<GltfReport> {
         Ok(out) => serde_json::from_slice::<serde_json::Value>(&out.stdout)
             .map_err(|e| format!("unreadable validator report: {e}")),
     };
-    let json = or_skip(found, "the glTF validator (npm gltf-validator)", "DRESSFORM_REQUIRE_PEERS")?;
+    let json =
+        or_skip(found, "the glTF validator (npm gltf-validator)", "DRESSFORM_REQUIRE_PEERS")?;
     let count = |k: &str| json["issues"][k].as_u64().unwrap_or(u64::MAX);
     Some(GltfReport { errors: count("numErrors"), warnings: count("numWarnings"), json })
 }
