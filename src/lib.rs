@@ -11,6 +11,7 @@
 //! - [`mannequin`]: the symmetric mannequin: layers, symmetry, watertight rebuild;
 //! - [`measure`]: height, crotch height, chest/waist/hip girths; Table 1 and Fig. 11;
 //! - [`pipeline`]: scan to mannequin in one call; [`profiles`]: the `profiles.json` format;
+//! - [`preview`]: pictures of a result: `preview.png` and `sections.svg`;
 //! - [`report`]: what `dressform info` says about a scan;
 //! - [`output`]: atomic file writes;
 //! - [`setpoints`]: the set-point file (actuator id → extension, mm) the controller drives to;
@@ -23,6 +24,7 @@ pub mod measure;
 pub mod mesh;
 pub mod output;
 pub mod pipeline;
+pub mod preview;
 pub mod profiles;
 pub mod regions;
 pub mod report;

@@ -18,6 +18,7 @@ mod formats;
 mod fuzz_readers;
 mod mannequin;
 mod mannequin_quality;
+mod preview;
 mod run_end_to_end;
 mod sim_cli;
 mod synthetic_bodies;

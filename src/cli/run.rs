@@ -12,6 +12,7 @@ use dressform::mannequin::MannequinOptions;
 use dressform::mesh::topology;
 use dressform::output::write_atomically;
 use dressform::pipeline::{STEPS, Symmetrized, symmetrize};
+use dressform::preview::{preview_png, sections_svg};
 use dressform::profiles::Profiles;
 use dressform::regions::Region;
 use dressform::scan::{self, Scan, format::Format};
@@ -31,7 +32,8 @@ pub struct RunArgs {
     link: LinkArgs,
     #[command(flatten)]
     sim: SimArgs,
-    /// Where to write mannequin.obj, profiles.json, measurements.json and setpoints.json.
+    /// Where to write mannequin.obj, profiles.json, measurements.json, setpoints.json,
+    /// preview.png and sections.svg.
     #[arg(long, default_value = "dressform-run")]
     out: PathBuf,
     #[command(flatten)]
@@ -71,7 +73,7 @@ pub fn shape_form(
     let profiles = Profiles::of(&result.mannequin, &result.comparison.levels);
     let fitted = fit(&profiles, form).map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
     let setpoints = SetPoints::new(form.name.clone(), fitted.positions_mm.clone());
-    write_outputs(out, &result, &profiles, &setpoints)?;
+    write_outputs(out, scan, &result, &profiles, &setpoints)?;
     bar.finish_and_clear();
 
     outln!("Symmetric mannequin and set-points written to {}.", out.display());
@@ -98,6 +100,7 @@ pub fn shape_form(
 
 fn write_outputs(
     out: &Path,
+    scan: &Scan,
     result: &Symmetrized,
     profiles: &Profiles,
     setpoints: &SetPoints,
@@ -112,6 +115,8 @@ fn write_outputs(
             "measurements.json",
             serde_json::to_vec_pretty(&result.comparison).map_err(Failure::other)?,
         ),
+        ("preview.png", preview_png(&scan.body, result)),
+        ("sections.svg", sections_svg(&scan.body, result).into_bytes()),
     ];
     for (name, bytes) in &outputs {
         write_atomically(&out.join(name), bytes).map_err(Failure::other)?;

@@ -7,6 +7,7 @@ use dressform::measure::Comparison;
 use dressform::mesh::topology;
 use dressform::output::write_atomically;
 use dressform::pipeline::{STEPS, symmetrize};
+use dressform::preview::{preview_png, sections_svg};
 use dressform::profiles::Profiles;
 use dressform::scan::{self, format::Format};
 use dressform::symmetry::Preserve;
@@ -16,7 +17,8 @@ use std::path::PathBuf;
 pub struct SymmetrizeArgs {
     /// The scan: an .obj, .ply or .stl file.
     scan: PathBuf,
-    /// Output directory (created if missing): mannequin.obj, profiles.json, measurements.json.
+    /// Output directory (created if missing): mannequin.obj, profiles.json, measurements.json,
+    /// preview.png, sections.svg.
     #[arg(short, long)]
     out: PathBuf,
     /// Torso layers.
@@ -80,6 +82,8 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
             pretty_json(&Profiles::of(&result.mannequin, &result.comparison.levels))?.into_bytes(),
         ),
         ("measurements.json", measurements.clone().into_bytes()),
+        ("preview.png", preview_png(&scan.body, &result)),
+        ("sections.svg", sections_svg(&scan.body, &result).into_bytes()),
     ];
     for (name, bytes) in &outputs {
         write_atomically(&args.out.join(name), bytes).map_err(Failure::other)?;
