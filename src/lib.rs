@@ -15,10 +15,13 @@
 //! - [`report`]: what `dressform info` says about a scan;
 //! - [`output`]: atomic file writes;
 //! - [`setpoints`]: the set-point file (actuator id → extension, mm) the controller drives to;
-//! - [`controller`]: the host controller: drives the robotic form over serial, slcan, SocketCAN or the simulated bus.
+//! - [`controller`]: the host controller: drives the robotic form over serial, slcan, SocketCAN or the simulated bus;
+//! - [`makehuman`]: the CC0 MakeHuman assets (base mesh, targets, 163-bone rig, weights) and posing them;
+//! - [`skinning`]: linear blend skinning (eq. 3) and its angle convention.
 
 pub mod controller;
 pub mod fitting;
+pub mod makehuman;
 pub mod mannequin;
 pub mod measure;
 pub mod mesh;
@@ -30,5 +33,6 @@ pub mod regions;
 pub mod report;
 pub mod scan;
 pub mod setpoints;
+pub mod skinning;
 pub mod slice;
 pub mod symmetry;

@@ -8,7 +8,8 @@
 //!   "rays": 360, "preserve": "tape",
 //!   "levels": { "chest": .., "waist": .., "hip": .. },   // measurement levels (mm)
 //!   "landmarks": { "height": .., "crotch": .., "ankle": .., "left_armpit": .., "right_armpit": ..,
-//!                  "neck": .., "centre_x": .., "arm_cut": .. },
+//!                  "neck": .., "centre_x": .., "left_armhole": {"armpit": [x, y, z],
+//!                  "shoulder_point": [x, y, z], "normal": [x, y, z]}, "right_armhole": .. },
 //!   "layers": [                       // legs (left, right), then torso; each bottom to top
 //!     { "region": "torso" | "left_leg" | "right_leg",
 //!       "z": 812.5, "centre": [x, y],

@@ -6,9 +6,13 @@
 //!
 //! Tracking starts from the torso at 60% of the height (between crotch and armpits for any
 //! standing adult) and follows the loop that contains the previous loop's centroid, up and
-//! down. The subject's left is +X in the canonical frame.
+//! down. The subject's left is +X in the canonical frame. Above the armpits the arms are cut
+//! off the torso at the armholes ([`Armhole`]), as a dress form's arm plates cut them.
 
+mod armhole;
 mod tracking;
+
+pub use armhole::Armhole;
 
 use crate::mesh::Mesh;
 use crate::slice::{Contour, Section, sections};
@@ -33,7 +37,7 @@ pub enum Region {
     Head,
 }
 
-/// Landmark heights (mm, canonical frame) and the arm cut.
+/// Landmark heights (mm, canonical frame) and the armholes.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Landmarks {
     /// Body height.
@@ -42,18 +46,18 @@ pub struct Landmarks {
     pub crotch: f64,
     /// The narrowest level of the legs near the floor (the ankles): where the legs end.
     pub ankle: f64,
-    /// Where the left arm joins the torso.
+    /// Where the left arm joins the torso: the height of `left_armhole.armpit`.
     pub left_armpit: f64,
-    /// Where the right arm joins the torso.
+    /// Where the right arm joins the torso: the height of `right_armhole.armpit`.
     pub right_armpit: f64,
     /// The narrowest torso level between the armpits and the head.
     pub neck: f64,
     /// The torso's centre line: its bounding-box centre (x) just below the armpits.
     pub centre_x: f64,
-    /// Half-width of the torso just below the armpits: the vertical planes
-    /// x = `centre_x` ± `arm_cut` cut the arms off the torso sections above the armpits, like a
-    /// dress form's arm plates.
-    pub arm_cut: f64,
+    /// Where the left arm is cut off the torso (the subject's left, +X).
+    pub left_armhole: Armhole,
+    /// Where the right arm is cut off the torso.
+    pub right_armhole: Armhole,
 }
 
 impl Landmarks {
@@ -142,8 +146,8 @@ impl BodyRegions {
     }
 
     /// The torso's section at each of `heights` (`None` where there is none): the largest
-    /// loop labelled torso (at and above the neck, head), with each arm cut off at
-    /// x = `centre_x` ± `arm_cut` above its armpit.
+    /// loop labelled torso (at and above the neck, head), clipped to the inner side of both
+    /// armholes (above each armpit), so that it holds no arm material.
     pub fn torso_sections(&self, body: &Mesh, heights: &[f64]) -> Vec<Option<Contour>> {
         let m = &self.landmarks;
         sections(body, heights)
@@ -152,15 +156,9 @@ impl BodyRegions {
                 let labels = self.label(&s);
                 let found = largest_with(&s, &labels, Region::Torso)
                     .or_else(|| largest_with(&s, &labels, Region::Head));
-                let lo = if s.height > m.right_armpit {
-                    m.centre_x - m.arm_cut
-                } else {
-                    f64::NEG_INFINITY
-                };
-                let hi =
-                    if s.height > m.left_armpit { m.centre_x + m.arm_cut } else { f64::INFINITY };
                 found.map(|c| {
-                    if lo.is_finite() || hi.is_finite() { c.clip_x(lo, hi) } else { c.clone() }
+                    let c = m.left_armhole.clip(c, s.height);
+                    m.right_armhole.clip(&c, s.height)
                 })
             })
             .collect()
@@ -226,8 +224,16 @@ impl BodyRegions {
 fn fallback_region(c: DVec2, z: f64, m: &Landmarks) -> Region {
     match () {
         _ if z >= m.neck => Region::Head,
-        _ if z >= m.crotch && (c.x - m.centre_x).abs() <= m.arm_cut => Region::Torso,
-        _ if z >= m.crotch => side(c.x - m.centre_x, Region::LeftArm, Region::RightArm),
+        _ if z >= m.crotch => {
+            let p = c.extend(z);
+            if m.left_armhole.beyond(p) > 0.0 {
+                Region::LeftArm
+            } else if m.right_armhole.beyond(p) > 0.0 {
+                Region::RightArm
+            } else {
+                Region::Torso
+            }
+        }
         _ => side(c.x - m.centre_x, Region::LeftLeg, Region::RightLeg),
     }
 }

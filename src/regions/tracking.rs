@@ -1,13 +1,11 @@
 //! Tracking loops from level to level to find the landmarks and label every loop.
 
+use super::armhole::{self, Armhole};
 use super::{BodyRegions, LabelledSection, Landmarks, Region, RegionError, side};
 use crate::mesh::Mesh;
 use crate::slice::{Contour, Section, sections};
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
-
-/// A jump of the torso's half-width between two levels that means an arm has joined (mm).
-const ARM_JOIN_JUMP_MM: f64 = 15.0;
 
 /// Index of the largest loop of `s` containing `p` (loops are sorted largest first).
 fn loop_containing(s: &Section, p: DVec2) -> Option<usize> {
@@ -58,6 +56,51 @@ fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, inside: DVec2) -> 
     above
 }
 
+/// The armpit between `below` (the arm's loop `arm` apart from the torso's loop `torso`)
+/// and `above` (joined), by bisection to 0.1 mm: the middle of the narrowest gap between the
+/// arm and the torso just below where they join. The arm grows upward into the join, so a
+/// level holds it apart as long as the torso's loop there does not overlap `arm`.
+fn refine_armpit(
+    body: &Mesh,
+    mut below: f64,
+    mut above: f64,
+    arm: &Contour,
+    torso: &Contour,
+) -> DVec3 {
+    let near = body.part(|tri| {
+        let z = tri.map(|v| body.positions[v as usize].z);
+        z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
+    });
+    let torso_c = torso.centroid();
+    let mut apart = (arm.clone(), torso.clone());
+    while above - below > 0.1 {
+        let mid = 0.5 * (below + above);
+        let s = &sections(&near, &[mid])[0];
+        let torso_here = loop_containing(s, torso_c).map(|t| &s.loops[t]);
+        let arm_here = s.loops.iter().find(|l| overlaps(arm, l));
+        match (torso_here, arm_here) {
+            (Some(t), Some(a)) if !overlaps(arm, t) => {
+                apart = (a.clone(), t.clone());
+                below = mid;
+            }
+            _ => above = mid,
+        }
+    }
+    let (p, q) = armhole::closest_points(&apart.0, &apart.1);
+    (0.5 * (p + q)).extend(above)
+}
+
+/// Whether loop `a` overlaps loop `b` seen from above: a point of `a` lies inside `b`.
+fn overlaps(a: &Contour, b: &Contour) -> bool {
+    a.points.iter().any(|&p| b.contains(p))
+}
+
+/// The x of the middle of a loop's bounding box.
+fn bbox_centre_x(c: &Contour) -> f64 {
+    let (lo, hi) = x_range(c);
+    0.5 * (lo + hi)
+}
+
 /// Tracks loops through `sections`, the body's sections every `step` mm from `floor` (at
 /// `floor + step * (i + 0.5)`) over its `height`.
 pub(super) fn track(
@@ -106,25 +149,33 @@ pub(super) fn track(
         }
     }
 
-    // Armpits: going up from the seed, the level where the torso suddenly widens on that side.
-    let half_widths: Vec<(usize, f64, f64)> = up
-        .iter()
-        .map(|&(i, k)| {
-            let (lo, hi) = x_range(&sections[i].loops[k]);
-            (i, hi, -lo)
+    // Armpits: going up from the seed, the first level where a loop beside the torso on that
+    // side joins it (a hanging arm at once, a raised arm's underside as a thin sliver).
+    let joining = |sign: f64| {
+        up.windows(2).find_map(|w| {
+            let ((i, t), (_, t_next)) = (w[0], w[1]);
+            let centre = bbox_centre_x(&sections[i].loops[t]);
+            let next = &sections[w[1].0].loops[t_next];
+            (0..sections[i].loops.len())
+                .filter(|&k| k != t)
+                .filter(|&k| sign * (sections[i].loops[k].centroid().x - centre) > 0.0)
+                .find(|&k| overlaps(&sections[i].loops[k], next))
+                .map(|k| (i, t, k))
         })
-        .collect();
-    let armpit = |pick: fn(&(usize, f64, f64)) -> f64, name: &'static str| {
-        half_widths
-            .windows(2)
-            .find(|w| pick(&w[1]) - pick(&w[0]) > ARM_JOIN_JUMP_MM)
-            .map(|w| (0.5 * (z_of(w[0].0) + z_of(w[1].0)), pick(&w[0])))
-            .ok_or(RegionError::NoArm { side: name })
     };
-    // The arm planes go where the torso's sides were just below each armpit.
-    let (left_armpit, left_side) = armpit(|w| w.1, "left")?;
-    let (right_armpit, right_side) = armpit(|w| w.2, "right")?;
-    let centre_x = 0.5 * (left_side - right_side);
+    let (Some(left), Some(right)) = (joining(1.0), joining(-1.0)) else {
+        let side = if joining(1.0).is_none() { "left" } else { "right" };
+        return Err(RegionError::NoArm { side });
+    };
+    // The centre line: the torso's bounding-box centre just below the lower armpit.
+    let (i, t, _) = if left.0 <= right.0 { left } else { right };
+    let centre_x = bbox_centre_x(&sections[i].loops[t]);
+    let armpit_point = |(i, t, k): (usize, usize, usize)| {
+        let (arm, torso_loop) = (&sections[i].loops[k], &sections[i].loops[t]);
+        refine_armpit(body, z_of(i), z_of(i + 1), arm, torso_loop)
+    };
+    let (left_pit, right_pit) = (armpit_point(left), armpit_point(right));
+    let (left_armpit, right_armpit) = (left_pit.z, right_pit.z);
 
     // Neck: the narrowest torso level between the armpits and the head's widest level.
     let armpit_z = left_armpit.max(right_armpit);
@@ -150,6 +201,15 @@ pub(super) fn track(
         .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
         .map_or(floor + 0.08 * height, |(i, _)| z_of(i));
 
+    // Armholes: through each armpit and its shoulder point, facing sideways.
+    let armhole = |pit: DVec3, sign: f64, name: &'static str| {
+        let shoulder = armhole::shoulder_point(body, sign, centre_x, pit, neck)
+            .ok_or(RegionError::NoArm { side: name })?;
+        Ok(Armhole::through(pit, shoulder, DVec3::NEG_Y, sign))
+    };
+    let left_armhole = armhole(left_pit, 1.0, "left")?;
+    let right_armhole = armhole(right_pit, -1.0, "right")?;
+
     let landmarks = Landmarks {
         height,
         crotch: refine_crotch(
@@ -163,7 +223,8 @@ pub(super) fn track(
         right_armpit,
         neck,
         centre_x,
-        arm_cut: 0.5 * (left_side + right_side),
+        left_armhole,
+        right_armhole,
     };
 
     let levels = sections

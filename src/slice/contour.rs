@@ -51,6 +51,12 @@ impl Contour {
         Contour { points: clip_half_plane(&keep_right, |p| hi - p.x) }
     }
 
+    /// The part of the loop where `normal . p <= offset` (Sutherland-Hodgman clipping; the cut
+    /// becomes a straight edge along the line).
+    pub fn clip_half_plane(&self, normal: DVec2, offset: f64) -> Contour {
+        Contour { points: clip_half_plane(&self.points, |p| offset - normal.dot(p)) }
+    }
+
     /// Whether `p` lies inside the loop (even-odd rule).
     pub fn contains(&self, p: DVec2) -> bool {
         let mut inside = false;
