@@ -7,7 +7,7 @@
 
 use crate::common;
 
-use common::quality::{near_horizontal_area, self_intersecting_pairs, width_jump};
+use common::quality::{near_horizontal_area, self_intersecting_pairs, silhouette_top, width_jump};
 use common::{largest_mirror_gap, makehuman};
 use dressform::mannequin::MannequinOptions;
 use dressform::mesh::{Mesh, smooth::DEFAULT_PASSES};
@@ -17,13 +17,21 @@ use dressform::scan::{self, Scan, format::Format, frame::FrameOptions};
 use dressform::symmetry::rays::bbox_centre;
 use glam::DVec3;
 use rayon::prelude::*;
-use sim::capture::{Artifacts, BodyParams, Pose, capture, generate};
+use sim::capture::{Artifacts, BodyParams, Pose, SyntheticBody, capture, generate};
 use std::path::Path;
 
-/// A body to test: its name and the scan.
+/// A body to test: its name, the scan, and for the generator's bodies in an A-pose the two
+/// acromion points (canonical frame), which end the shoulder line.
 struct Case {
     name: String,
     scan: Scan,
+    acromions: Option<[DVec3; 2]>,
+}
+
+/// The generator's acromion points of `body` in the canonical frame of `scan`.
+fn acromions(body: &SyntheticBody, scan: &Scan) -> Option<[DVec3; 2]> {
+    let sides = [&body.truth.landmarks.left, &body.truth.landmarks.right];
+    Some(sides.map(|s| scan.frame.to_canonical(DVec3::from_array(s.acromion))))
 }
 
 fn mesh_of(surface: &sim::capture::TriangleSurface) -> Mesh {
@@ -37,7 +45,7 @@ fn generated(name: String, params: &BodyParams) -> Case {
     let body = generate(params).unwrap();
     let scan = scan::from_mesh(mesh_of(&body.surface), Path::new(&name), &FrameOptions::default())
         .unwrap();
-    Case { name, scan }
+    Case { acromions: acromions(&body, &scan), name, scan }
 }
 
 /// The demo's customer, scanned as the demo scans it, denoised as the commands do.
@@ -47,18 +55,20 @@ fn demo_customer() -> Case {
     let mut scan =
         scan::from_mesh(mesh_of(&raw), Path::new("demo"), &FrameOptions::default()).unwrap();
     scan.body.taubin_smooth(DEFAULT_PASSES);
-    Case { name: "demo".into(), scan }
+    Case { acromions: acromions(&body, &scan), name: "demo".into(), scan }
 }
 
+/// The asymmetric example; its left arm, raised level with the shoulder, hides the shoulder
+/// line in the front view, so that is not compared.
 fn asymmetric() -> Case {
     let params = BodyParams { pose: Pose::asymmetric_example(), ..BodyParams::default() };
-    generated("asymmetric".into(), &params)
+    Case { acromions: None, ..generated("asymmetric".into(), &params) }
 }
 
 fn makehuman_base() -> Option<Case> {
     let dir = makehuman()?;
     let scan = scan::load(&dir.join("base.obj"), &FrameOptions::default()).unwrap();
-    Some(Case { name: "makehuman".into(), scan })
+    Some(Case { name: "makehuman".into(), scan, acromions: None })
 }
 
 /// What one mannequin measures.
@@ -74,17 +84,30 @@ struct Report {
     /// Mannequin crotch height minus the body's (mm).
     crotch_change: f64,
     mirror_gap: f64,
-    /// The largest change of a torso layer's tape girth, measured on the mesh (mm).
+    /// The largest change of a torso layer's tape girth below the shoulder points, measured
+    /// on the mesh (mm).
     torso_girth_change: f64,
+    /// The same above the shoulder points, where the shoulders are eased (mm).
+    shoulder_girth_change: f64,
+    /// The largest difference between a torso layer's reported tape girth and its girth on
+    /// the mesh (mm).
+    recorded_girth_error: f64,
     /// Abduction of the input's left leg, of its mirrored right leg, and of the mannequin's
     /// legs (degrees).
     leg_deg: [f64; 3],
+    /// The largest height difference between the mannequin's shoulder line and the body's
+    /// (mm), where the shoulders are known.
+    shoulder_line: Option<f64>,
 }
 
 /// How far above the crotch the ledge check looks (mm), from the issue.
 const CROTCH_BAND_MM: f64 = 50.0;
 /// "Near-horizontal": a face normal within this angle of vertical (degrees), from the issue.
 const HORIZONTAL_TILT_DEG: f64 = 10.0;
+/// The largest width jump allowed (mm), from the issue: a smooth body stays under it.
+const WIDTH_JUMP_MM: f64 = 15.0;
+/// How far the mannequin's shoulder line may be from the body's (mm), from the issue.
+const SHOULDER_LINE_MM: f64 = 5.0;
 /// How close the mannequin's leg direction is to the mean of the input's (degrees).
 const LEG_STANCE_DEG: f64 = 0.5;
 /// The largest near-horizontal face allowed in that band (mm²: 1 cm², from the issue).
@@ -110,19 +133,30 @@ fn report(case: &Case, out: &Symmetrized) -> Report {
     let heights: Vec<f64> = m.torso.iter().map(|l| l.z).collect();
     let input = out.regions.torso_sections(&case.scan.body, &heights);
     let ours = dressform::measure::central_loops(&m.mesh, m.axis, &heights);
-    let torso_girth_change = input
-        .iter()
-        .zip(&ours)
-        .map(|(a, b)| match (a, b) {
-            (Some(a), Some(b)) => (a.tape_girth() - b.tape_girth()).abs(),
-            _ => f64::INFINITY,
-        })
-        .fold(0.0, f64::max);
+    // Below the shoulder points every layer keeps its section's girth; above them the
+    // shoulders are eased into a dress form's slope, and each layer keeps the girth it reports.
+    let shoulders = lm.left_armhole.shoulder_point.z.min(lm.right_armhole.shoulder_point.z);
+    let (mut torso_girth_change, mut shoulder_girth_change, mut recorded_girth_error) =
+        (0.0_f64, 0.0_f64, 0.0_f64);
+    for ((layer, a), b) in m.torso.iter().zip(&input).zip(&ours) {
+        let (Some(a), Some(b)) = (a, b) else { panic!("{}: no loop at {}", case.name, layer.z) };
+        let change = (a.tape_girth() - b.tape_girth()).abs();
+        if layer.z < shoulders {
+            torso_girth_change = torso_girth_change.max(change);
+        } else {
+            shoulder_girth_change = shoulder_girth_change.max(change);
+        }
+        recorded_girth_error = recorded_girth_error.max((layer.tape_girth - b.tape_girth()).abs());
+    }
     let band = (lm.crotch, lm.crotch + CROTCH_BAND_MM);
     // The input's torso and legs: its arms hang beside the hips in this band.
     let (input_body, mut body) = (&case.scan.body, case.scan.body.clone());
+    let armpit_x = [lm.left_armhole, lm.right_armhole]
+        .iter()
+        .map(|a| (a.armpit.x - lm.centre_x).abs())
+        .fold(0.0, f64::max);
     body.retain_triangles(|t| {
-        input_body.corners(t).iter().all(|p| (p.x - lm.centre_x).abs() <= ARMS_BEYOND * lm.arm_cut)
+        input_body.corners(t).iter().all(|p| (p.x - lm.centre_x).abs() <= ARMS_BEYOND * armpit_x)
     });
     let leg_heights: Vec<f64> = m.left_leg.iter().map(|l| l.z).collect();
     let input_leg = |region| {
@@ -144,15 +178,55 @@ fn report(case: &Case, out: &Symmetrized) -> Report {
         crotch_change: crotch_on_plane(&m.mesh, m.axis) - lm.crotch,
         mirror_gap: largest_mirror_gap(&m.mesh, m.axis),
         torso_girth_change,
+        shoulder_girth_change,
+        recorded_girth_error,
         leg_deg: [
             input_leg(Region::LeftLeg),
             -input_leg(Region::RightLeg),
             abduction_deg(&mannequin_leg),
         ],
+        shoulder_line: case.acromions.map(|a| shoulder_line_gap(case, out, a)),
     }
 }
 
-/// How far out from the torso's centre line the arms begin, in torso half-widths (`arm_cut`).
+/// Where the shoulder line starts beside the neck: this far outside the neck's top layer (mm).
+const BESIDE_NECK_MM: f64 = 10.0;
+/// Where it ends: this far inside the acromion or the armhole (mm), where the arm plate begins.
+const INSIDE_ACROMION_MM: f64 = 5.0;
+
+/// The largest height difference (mm) between the front silhouettes' shoulder lines of the
+/// mannequin and of the body (the mean of its left side and its mirrored right side), from
+/// beside the neck to the armhole, below the neck.
+fn shoulder_line_gap(case: &Case, out: &Symmetrized, acromions: [DVec3; 2]) -> f64 {
+    let m = &out.mannequin;
+    let neck = m.torso.last().expect("torso layers");
+    let neck_half = neck.points.iter().map(|p| (p.x - m.axis).abs()).fold(0.0, f64::max);
+    // The line ends at the acromion or, where the armhole's shoulder point is found inside it,
+    // at the mannequin's armhole.
+    let lm = &m.landmarks;
+    let armhole = [lm.left_armhole, lm.right_armhole]
+        .iter()
+        .map(|a| 0.5 * (a.shoulder_point.x - m.axis).abs())
+        .sum::<f64>();
+    let reach = (0.5 * (acromions[0].x - acromions[1].x)).min(armhole) - INSIDE_ACROMION_MM;
+    let offsets: Vec<f64> =
+        (0..).map(|k| neck_half + BESIDE_NECK_MM + k as f64).take_while(|&u| u <= reach).collect();
+    let at = |mesh: &Mesh, sign: f64| {
+        let xs: Vec<f64> = offsets.iter().map(|u| m.axis + sign * u).collect();
+        silhouette_top(mesh, &xs, neck.z)
+    };
+    let (left, right, ours) =
+        (at(&case.scan.body, 1.0), at(&case.scan.body, -1.0), at(&m.mesh, 1.0));
+    assert!(!offsets.is_empty(), "{}: no shoulder between the neck and the acromion", case.name);
+    (0..offsets.len())
+        .map(|k| {
+            let body = 0.5 * (left[k].expect("body") + right[k].expect("body"));
+            (ours[k].expect("mannequin") - body).abs()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// How far out from the torso's centre line the hanging arms are, in armpit half-widths.
 const ARMS_BEYOND: f64 = 1.5;
 
 /// A leg's abduction from its section centres (height, x): the angle from vertical of the
@@ -188,7 +262,7 @@ fn check_all(cases: Vec<Case>) {
         })
         .collect();
     eprintln!(
-        "{:<12} {:>15} {:>9} {:>22} {:>7} {:>7} {:>7} {:>17}",
+        "{:<12} {:>15} {:>9} {:>22} {:>7} {:>7} {:>7} {:>8} {:>17} {:>8}",
         "mannequin",
         "width jump (z)",
         "crossing",
@@ -196,11 +270,13 @@ fn check_all(cases: Vec<Case>) {
         "crotch",
         "mirror",
         "girth",
-        "legs deg: L/R/out"
+        "shoulder",
+        "legs deg: L/R/out",
+        "line"
     );
     for r in &reports {
         eprintln!(
-            "{:<12} {:>6.1} ({:>6.0}) {:>9} {:>6.1} {:>7.0} {:>7.0} {:>+7.2} {:>7.3} {:>7.3} {:>5.1} {:>5.1} {:>5.1}",
+            "{:<12} {:>6.1} ({:>6.0}) {:>9} {:>6.1} {:>7.0} {:>7.0} {:>+7.2} {:>7.3} {:>7.3} {:>8.1} {:>5.1} {:>5.1} {:>5.1} {:>8}",
             r.name,
             r.width_jump.0,
             r.width_jump.1,
@@ -211,14 +287,20 @@ fn check_all(cases: Vec<Case>) {
             r.crotch_change,
             r.mirror_gap,
             r.torso_girth_change,
+            r.shoulder_girth_change,
             r.leg_deg[0],
             r.leg_deg[1],
-            r.leg_deg[2]
+            r.leg_deg[2],
+            r.shoulder_line.map_or("-".into(), |g| format!("{g:.1}"))
         );
     }
     for r in &reports {
         let name = &r.name;
         assert_eq!(r.self_intersections, 0, "{name}: self-intersecting triangle pairs");
+        assert!(r.width_jump.0 <= WIDTH_JUMP_MM, "{name}: width jump {:?}", r.width_jump);
+        if let Some(gap) = r.shoulder_line {
+            assert!(gap <= SHOULDER_LINE_MM, "{name}: shoulder line {gap:.1} mm from the body's");
+        }
         assert!(r.crotch_ledge.1 <= LEDGE_FACE_MM2, "{name}: a ledge at the crotch: {r:?}");
         assert!(
             r.crotch_ledge.0 <= r.body_crotch_ledge + LEDGE_FACE_MM2,
@@ -231,6 +313,7 @@ fn check_all(cases: Vec<Case>) {
             r.mirror_gap
         );
         assert!(r.torso_girth_change < 0.1, "{name}: a torso layer's girth changed: {r:?}");
+        assert!(r.recorded_girth_error < 0.1, "{name}: a layer misreports its girth: {r:?}");
         // The stance: the mean of the left leg's direction and the right leg's mirrored.
         let stance = 0.5 * (r.leg_deg[0] + r.leg_deg[1]);
         assert!((r.leg_deg[2] - stance).abs() < LEG_STANCE_DEG, "{name}: legs {:?}", r.leg_deg);
