@@ -6,10 +6,10 @@
 //!   "frame": "canonical: mm, Z up, floor at z = 0, +X = subject's left, facing -Y",
 //!   "axis_x": 0.0,                    // the symmetry plane x = axis_x
 //!   "rays": 360, "preserve": "tape",
-//!   "levels": { "chest": .., "waist": .., "hip": .. },   // measurement levels (mm)
-//!   "landmarks": { "height": .., "crotch": .., "ankle": .., "left_armpit": .., "right_armpit": ..,
-//!                  "neck": .., "centre_x": .., "left_armhole": {"armpit": [x, y, z],
-//!                  "shoulder_point": [x, y, z], "normal": [x, y, z]}, "right_armhole": .. },
+//!   "levels": { "chest_mm": .., "waist_mm": .., "hip_mm": .. },   // measurement levels
+//!   "landmarks": { "height_mm": .., "crotch_mm": .., "ankle_mm": .., "left_armpit_mm": .., "right_armpit_mm": ..,
+//!                  "neck_mm": .., "centre_x_mm": .., "left_armhole": {"armpit_mm": [x, y, z],
+//!                  "shoulder_point_mm": [x, y, z], "normal": [x, y, z]}, "right_armhole": .. },
 //!   "layers": [                       // legs (left, right), then torso; each bottom to top
 //!     { "region": "torso" | "left_leg" | "right_leg",
 //!       "z": 812.5, "centre": [x, y],
@@ -20,15 +20,63 @@
 //!   ]
 //! }
 //! ```
+//!
+//! Loading ([`Profiles::load`]) refuses a file that would give meaningless set-points, naming
+//! every problem by its field (`layers[12].points[40]`): the wrong format, non-finite or
+//! farther than [`MAX_COORDINATE_MM`] coordinates, heights, levels and landmarks, layers
+//! without points or with fewer than three, point counts that differ within a region,
+//! heights out of order within a region, negative or non-finite girths, and a region the
+//! form needs with fewer than two layers.
 
 use crate::mannequin::{Layer, Mannequin};
 use crate::measure::Levels;
 use crate::regions::{Landmarks, Region};
 use crate::symmetry::Preserve;
 use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
 
 /// The format tag of this version.
 pub const FORMAT: &str = "dressform-profiles/1";
+
+/// The farthest any coordinate, height or level may lie from the origin, mm: a standing
+/// adult fits within 2.5 m, so 5 m leaves room for any offset and still refuses garbage
+/// (1e308, a file in metres read as millimetres is fine, one in micrometres is not).
+pub const MAX_COORDINATE_MM: f64 = 5000.0;
+
+/// The fewest layers of a region the form needs: rings are placed between two layers.
+const MIN_LAYERS: usize = 2;
+
+/// The fewest points of a ring.
+const MIN_POINTS: usize = 3;
+
+/// Why a profiles file cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum ProfilesError {
+    /// It cannot be read.
+    #[error("{}: cannot read: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// It is not a profiles file.
+    #[error("{}: not a profiles file: {message}", path.display())]
+    Syntax {
+        /// The file.
+        path: PathBuf,
+        /// What the JSON parser said.
+        message: String,
+    },
+    /// Its content cannot give set-points.
+    #[error("{}: {}", path.display(), problems.join("; "))]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// Every problem, each naming its field.
+        problems: Vec<String>,
+    },
+}
 
 /// The symmetric profiles of a mannequin.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -72,6 +120,11 @@ pub struct ProfileLayer {
     pub contour_length: f64,
 }
 
+/// A region as the file spells it.
+fn region_name(region: Region) -> String {
+    serde_json::to_value(region).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default()
+}
+
 impl From<&Layer> for ProfileLayer {
     fn from(l: &Layer) -> Self {
         ProfileLayer {
@@ -88,6 +141,141 @@ impl From<&Layer> for ProfileLayer {
 }
 
 impl Profiles {
+    /// Reads a profiles file and checks it ([`Profiles::validate`]) for a form that shapes
+    /// `regions`.
+    pub fn load(path: &Path, regions: &[Region]) -> Result<Self, ProfilesError> {
+        let bytes = std::fs::read(path)
+            .map_err(|source| ProfilesError::Read { path: path.to_path_buf(), source })?;
+        let profiles: Profiles = serde_json::from_slice(&bytes).map_err(|e| {
+            ProfilesError::Syntax { path: path.to_path_buf(), message: e.to_string() }
+        })?;
+        profiles
+            .validate(regions)
+            .map_err(|problems| ProfilesError::Invalid { path: path.to_path_buf(), problems })?;
+        Ok(profiles)
+    }
+
+    /// Every problem that would make set-points for a form shaping `regions` meaningless,
+    /// each naming its field (see the module documentation).
+    pub fn validate(&self, regions: &[Region]) -> Result<(), Vec<String>> {
+        let mut problems = Vec::new();
+        if self.format != FORMAT {
+            problems.push(format!("format: \"{}\", expected \"{FORMAT}\"", self.format));
+        }
+        let mut place = |field: String, value: f64| {
+            if !(value.is_finite() && value.abs() <= MAX_COORDINATE_MM) {
+                problems.push(format!("{field}: {value} is not within ±{MAX_COORDINATE_MM} mm"));
+            }
+        };
+        place("axis_x".into(), self.axis_x);
+        let Levels { chest, waist, hip } = self.levels;
+        for (name, value) in [("chest_mm", chest), ("waist_mm", waist), ("hip_mm", hip)] {
+            place(format!("levels.{name}"), value);
+        }
+        let l = &self.landmarks;
+        for (name, value) in [
+            ("height_mm", l.height),
+            ("crotch_mm", l.crotch),
+            ("ankle_mm", l.ankle),
+            ("left_armpit_mm", l.left_armpit),
+            ("right_armpit_mm", l.right_armpit),
+            ("neck_mm", l.neck),
+            ("centre_x_mm", l.centre_x),
+        ] {
+            place(format!("landmarks.{name}"), value);
+        }
+        for (name, a) in [("left_armhole", &l.left_armhole), ("right_armhole", &l.right_armhole)] {
+            for (part, p) in [("armpit_mm", a.armpit), ("shoulder_point_mm", a.shoulder_point)] {
+                for (c, v) in p.to_array().into_iter().enumerate() {
+                    place(format!("landmarks.{name}.{part}[{c}]"), v);
+                }
+            }
+        }
+        for (i, layer) in self.layers.iter().enumerate() {
+            place(format!("layers[{i}].z"), layer.z);
+            place(format!("layers[{i}].centre[0]"), layer.centre[0]);
+            place(format!("layers[{i}].centre[1]"), layer.centre[1]);
+            // The first bad point of a layer stands for the others.
+            if let Some((k, c, v)) = layer.points.iter().enumerate().find_map(|(k, p)| {
+                p.iter()
+                    .enumerate()
+                    .find(|(_, v)| !(v.is_finite() && v.abs() <= MAX_COORDINATE_MM))
+                    .map(|(c, v)| (k, c, *v))
+            }) {
+                place(format!("layers[{i}].points[{k}][{c}]"), v);
+            }
+        }
+        for (i, layer) in self.layers.iter().enumerate() {
+            if layer.points.len() < MIN_POINTS {
+                problems.push(format!(
+                    "layers[{i}].points: {} points, a ring needs at least {MIN_POINTS}",
+                    layer.points.len()
+                ));
+            }
+            for (name, girth) in [
+                ("input_tape_girth", layer.input_tape_girth),
+                ("input_contour_length", layer.input_contour_length),
+                ("tape_girth", layer.tape_girth),
+                ("contour_length", layer.contour_length),
+            ] {
+                if !(girth.is_finite()
+                    && (0.0..=MAX_COORDINATE_MM * std::f64::consts::TAU).contains(&girth))
+                {
+                    problems.push(format!("layers[{i}].{name}: {girth} is not a girth in mm"));
+                }
+            }
+        }
+        problems.extend(self.region_problems(regions));
+        if problems.is_empty() { Ok(()) } else { Err(problems) }
+    }
+
+    /// Per region: enough layers where the form needs them, equal point counts, heights in
+    /// order.
+    fn region_problems(&self, regions: &[Region]) -> Vec<String> {
+        let mut problems = Vec::new();
+        if self.layers.is_empty() {
+            problems.push("layers: empty".into());
+        }
+        let mut seen: Vec<Region> = Vec::new();
+        for (i, layer) in self.layers.iter().enumerate() {
+            if seen.contains(&layer.region) {
+                continue;
+            }
+            seen.push(layer.region);
+            let of_region: Vec<(usize, &ProfileLayer)> =
+                self.layers.iter().enumerate().filter(|(_, l)| l.region == layer.region).collect();
+            let name = region_name(layer.region);
+            let count = layer.points.len();
+            for &(k, other) in &of_region[1..] {
+                if other.points.len() != count {
+                    problems.push(format!(
+                        "layers[{k}].points: {} points, the first {name} layer (layers[{i}]) has {count}",
+                        other.points.len()
+                    ));
+                }
+            }
+            for pair in of_region.windows(2) {
+                let ((_, below), (k, above)) = (pair[0], pair[1]);
+                if above.z < below.z {
+                    problems.push(format!(
+                        "layers[{k}].z: {} is below the {name} layer before it ({}): layers go bottom to top",
+                        above.z, below.z
+                    ));
+                }
+            }
+        }
+        for &region in regions {
+            let count = self.layers.iter().filter(|l| l.region == region).count();
+            if count < MIN_LAYERS {
+                problems.push(format!(
+                    "layers: {count} {} layer(s); the form's rings need at least {MIN_LAYERS}",
+                    region_name(region)
+                ));
+            }
+        }
+        problems
+    }
+
     /// The profiles of `m`, whose body was measured at `levels`.
     pub fn of(m: &Mannequin, levels: &Levels) -> Self {
         Profiles {

@@ -4,23 +4,29 @@
 //! {
 //!   "format": "dressform-setpoints/1",
 //!   "form": "reference",
-//!   "positions_mm": { "chest-l1": 23.5, "chest-front": 12.0 }
+//!   "positions_mm": { "chest-l1": 23.5, "chest-front": 12.0 },
+//!   "target_girths_mm": { "chest": 961.8, "waist": 801.2 }
 //! }
 //! ```
 //!
 //! * `format` is exactly `dressform-setpoints/1`;
 //! * `form` is the `name` of the form description the file was made for;
 //! * `positions_mm` maps an actuator id of that form to its extension in mm from the home
-//!   (fully retracted) end. Actuators the file leaves out stay where they are.
+//!   (fully retracted) end. Actuators the file leaves out stay where they are;
+//! * `target_girths_mm` (optional; `setpoints` and `run` write it) maps a ring of that form
+//!   to the mannequin's tape girth the ring should take: after the move `drive` compares
+//!   each ring's reached girth with it (`fitting::outcome`).
 //!
-//! Loading refuses an unknown actuator id, a non-finite value or another form's name, naming
-//! the file and the field or actuator. [`SetPoints::check`] then refuses positions outside
+//! Loading refuses an id given twice (JSON parsers would keep the last silently), an unknown
+//! actuator or ring, a non-finite value, a girth that is not positive, or another form's
+//! name, naming the file and the field or actuator. [`SetPoints::check`] then refuses positions outside
 //! `[0, stroke]` with the list of offenders, or clamps them into the stroke and reports them
 //! (`--clamp`); only a [`Checked`] set of targets can be driven.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use serde::de::{Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, Serialize};
 use sim::form::FormDescription;
 
@@ -39,7 +45,33 @@ pub struct SetPoints {
     /// The form's name.
     pub form: String,
     /// Actuator id → extension from home, mm.
+    #[serde(deserialize_with = "unique_keys")]
     pub positions_mm: BTreeMap<String, f64>,
+    /// Ring → the mannequin's tape girth it should take, mm (empty: not recorded).
+    #[serde(default, deserialize_with = "unique_keys", skip_serializing_if = "BTreeMap::is_empty")]
+    pub target_girths_mm: BTreeMap<String, f64>,
+}
+
+/// A JSON object into a map, refusing a key given twice (by name).
+fn unique_keys<'de, D: Deserializer<'de>>(d: D) -> Result<BTreeMap<String, f64>, D::Error> {
+    struct Unique;
+    impl<'de> Visitor<'de> for Unique {
+        type Value = BTreeMap<String, f64>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("an object of numbers")
+        }
+        fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+            let mut out = BTreeMap::new();
+            while let Some((key, value)) = map.next_entry::<String, f64>()? {
+                if out.contains_key(&key) {
+                    return Err(serde::de::Error::custom(format!("\"{key}\" is given twice")));
+                }
+                out.insert(key, value);
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_map(Unique)
 }
 
 /// Why a set-point file cannot be used.
@@ -102,7 +134,18 @@ pub struct Checked {
 impl SetPoints {
     /// Set-points for the form named `form` (format [`FORMAT`]).
     pub fn new(form: impl Into<String>, positions_mm: BTreeMap<String, f64>) -> Self {
-        Self { format: FORMAT.to_string(), form: form.into(), positions_mm }
+        Self {
+            format: FORMAT.to_string(),
+            form: form.into(),
+            positions_mm,
+            target_girths_mm: BTreeMap::new(),
+        }
+    }
+
+    /// The same, with the mannequin's girth each ring should take (ring → mm).
+    pub fn with_target_girths(mut self, target_girths_mm: BTreeMap<String, f64>) -> Self {
+        self.target_girths_mm = target_girths_mm;
+        self
     }
 
     /// Parses set-point JSON; `path` names the source in errors. Checks the format and that
@@ -138,7 +181,7 @@ impl SetPoints {
     }
 
     /// Every problem with using these set-points on `form`: another form's name, unknown
-    /// actuator ids, non-finite values.
+    /// actuator ids or rings, non-finite values, girths that are not positive.
     pub fn validate(&self, form: &FormDescription) -> Result<(), Vec<String>> {
         let mut problems = Vec::new();
         if self.form != form.name {
@@ -152,6 +195,13 @@ impl SetPoints {
                 problems.push(format!("positions_mm.{id}: the form has no actuator \"{id}\""));
             } else if !mm.is_finite() {
                 problems.push(format!("positions_mm.{id}: {mm} is not a finite number"));
+            }
+        }
+        for (ring, &mm) in &self.target_girths_mm {
+            if !form.rings.iter().any(|r| &r.name == ring) {
+                problems.push(format!("target_girths_mm.{ring}: the form has no ring \"{ring}\""));
+            } else if !(mm.is_finite() && mm > 0.0) {
+                problems.push(format!("target_girths_mm.{ring}: {mm} is not a positive girth"));
             }
         }
         if problems.is_empty() { Ok(()) } else { Err(problems) }

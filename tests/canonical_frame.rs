@@ -101,7 +101,7 @@ fn overrides_win_over_detection() {
         "info",
         "--json",
         "--units",
-        "cm",
+        "dm",
         "--up",
         "y",
         "--facing",
@@ -110,8 +110,52 @@ fn overrides_win_over_detection() {
     ]);
     assert_eq!(code, 0, "{stderr}");
     let info: serde_json::Value = serde_json::from_str(&stdout).unwrap();
-    assert_eq!(info["frame"]["units"], "cm");
+    assert_eq!(info["frame"]["units"], "dm");
+    assert_eq!(info["frame"]["units_detected"], false);
     assert_eq!(info["frame"]["facing_axis"], "-z");
     assert_eq!(info["frame"]["facing_detected"], false);
-    assert!((info["body"]["height_mm"].as_f64().unwrap() - 166.6).abs() < 0.2);
+    assert!((info["body"]["height_mm"].as_f64().unwrap() - 1666.0).abs() < 2.0);
+}
+
+/// The generator's default customer written as a millimetre, Z-up PLY.
+fn millimetre_z_up_scan(dir: &Path) -> std::path::PathBuf {
+    let body = sim::capture::generate(&sim::capture::BodyParams::default()).unwrap();
+    let mesh = common::mesh_of(&body);
+    let path = dir.join("customer_mm_z_up.ply");
+    write_atomically(&path, &Format::Ply.encode(&mesh)).unwrap();
+    path
+}
+
+#[test]
+fn overrides_no_standing_person_has_are_refused_naming_the_fix() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scan = millimetre_z_up_scan(tmp.path());
+    let file = scan.to_str().unwrap();
+    // (override, what the message must name)
+    let cases: [(&[&str], &[&str]); 5] = [
+        (&["--units", "cm"], &["17000 mm tall", "--units mm"]),
+        (&["--units", "m"], &["--units mm"]),
+        (&["--up", "y"], &["as tall as it is wide", "--up +z"]),
+        (&["--up", "-z"], &["head is below the feet", "--up +z"]),
+        (&["--up", "x"], &["--up +z"]),
+    ];
+    for command in ["info", "measure", "slice"] {
+        for (flags, named) in cases {
+            let mut args = vec![command, file];
+            args.extend_from_slice(flags);
+            if command == "slice" {
+                args.extend(["--heights", "1000"]);
+            }
+            let (code, _, stderr) = dressform(&args);
+            assert_eq!(code, 2, "{args:?}: {stderr}");
+            assert_eq!(stderr.trim().lines().count(), 1, "one line: {stderr}");
+            assert!(stderr.contains(file), "{stderr}");
+            for n in named {
+                assert!(stderr.contains(n), "{args:?}: {stderr:?} lacks {n:?}");
+            }
+        }
+    }
+    // The right overrides pass.
+    let (code, _, stderr) = dressform(&["info", file, "--units", "mm", "--up", "z"]);
+    assert_eq!(code, 0, "{stderr}");
 }

@@ -73,3 +73,57 @@ fn status_lists_every_node_and_estop_needs_a_link() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/dev/does-not-exist"));
 }
+
+#[test]
+fn a_failing_log_is_named_when_it_fails_and_exits_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = setpoints(&dir, r#""chest-l1": 3.5"#);
+    // /dev/full takes the file's creation and refuses every write: a full disk.
+    let out = dressform(&["drive", &file, "--sim", "--log", "/dev/full"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("candump log /dev/full"), "{stderr}");
+    // Reported while the form moved, then again as the reason for the exit status.
+    assert!(stderr.contains("(the move goes on)"), "{stderr}");
+}
+
+#[test]
+fn the_builtin_form_serves_every_command() {
+    let out = dressform(&["form", "show", "--toml"]);
+    assert!(out.status.success());
+    let toml = String::from_utf8_lossy(&out.stdout);
+    let form = sim::form::FormDescription::from_toml_str(&toml).unwrap();
+    assert_eq!(form, sim::form::reference());
+    let out = dressform(&["form", "show"]);
+    let summary = String::from_utf8_lossy(&out.stdout);
+    assert!(summary.contains("form \"reference\": 8 nodes, 9 rings, 64 actuators"), "{summary}");
+    assert!(summary.contains("waist") && summary.contains("695 .. 1038"), "{summary}");
+
+    // estop --sim and status --sim: a simulated form that lives for the command.
+    let out = dressform(&["estop", "--sim"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    assert!(stdout.contains("started for this command"), "{stdout}");
+    assert_eq!(stdout.matches("EMERGENCY_STOP").count(), 8, "{stdout}");
+    let out = dressform(&["status", "--sim"]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("started for this command"));
+    let out = dressform(&["reset", "--sim"]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("no node holds a fault"));
+}
+
+#[test]
+fn a_fault_during_homing_names_the_actuator_in_words() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = setpoints(&dir, r#""chest-l1": 3.5"#);
+    let out = dressform(&["drive", &file, "--sim", "--faults", "chest-l1:stall@0s"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("fault on node 2 (chest), actuator chest-l1: following error of"),
+        "{stderr}"
+    );
+    for debug in ["Some(", "Faults(", "FollowingError", "{", "homing did not finish"] {
+        assert!(!stderr.contains(debug), "{debug}: {stderr}");
+    }
+}

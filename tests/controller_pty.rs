@@ -14,7 +14,8 @@ use sim::form::reference;
 use sim::serve::{ServeConfig, Server, Transport as Served, serve};
 use tokio::runtime::Runtime;
 
-fn start(transport: Served) -> (Runtime, Server) {
+/// The reference form served on a pty of `transport`, on a runtime of its own.
+pub(crate) fn start(transport: Served) -> (Runtime, Server) {
     let runtime =
         tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build().unwrap();
     let server = {
@@ -82,9 +83,9 @@ fn drives_the_form_over_slcan_on_a_pty() {
 
 #[test]
 fn an_emergency_stop_over_the_serial_pty_reaches_every_node() {
-    let (runtime, server) = start(Served::SerialPty);
+    let (_runtime, server) = start(Served::SerialPty);
     let connection = Connection::open(&LinkSpec::Serial(server.device_path().into())).unwrap();
-    runtime.block_on(dressform::controller::emergency_stop(connection)).unwrap();
+    dressform::controller::emergency_stop(&connection).unwrap();
     std::thread::sleep(std::time::Duration::from_millis(100));
     for node in server.form().state().nodes {
         assert!(node.faults.contains(Faults::EMERGENCY_STOP), "node {}", node.node.get());

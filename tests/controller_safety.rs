@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
 use dressform::controller::transport::sim::SimBus;
-use dressform::controller::{DriveOptions, Transport, TransportError, drive};
+use dressform::controller::{DriveOptions, Gate, Transport, TransportError, drive};
 use dressform::setpoints::SetPoints;
 use firmware_protocol::{Address, Link, Message, Packet};
 use proptest::prelude::*;
@@ -30,6 +30,10 @@ impl Transport for Recording {
 
     fn device(&self) -> String {
         self.inner.device()
+    }
+
+    fn gate(&self) -> &Gate {
+        self.inner.gate()
     }
 
     async fn send(&mut self, packet: Packet) -> Result<(), TransportError> {

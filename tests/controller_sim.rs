@@ -9,7 +9,8 @@ use std::time::Duration;
 use dressform::controller::simulated::{SimConfig, SimDriveError, drive_on_sim};
 use dressform::controller::transport::sim::SimBus;
 use dressform::controller::{
-    DriveError, DriveOptions, MoveError, NodeProblem, SessionError, emergency_stop,
+    DriveError, DriveOptions, MoveError, NodeProblem, SessionError, StopCause, Transport,
+    emergency_stop,
 };
 use dressform::setpoints::SetPoints;
 use firmware_protocol::drive::{DriveState, Faults};
@@ -144,12 +145,34 @@ async fn a_fault_stops_every_actuator_and_names_the_actuator() {
         .await
         .unwrap_err();
     let text = error.to_string();
-    let SimDriveError::Drive(DriveError::Move(MoveError::Fault { node, actuator, .. })) = error
-    else {
+    let SimDriveError::Drive(DriveError::Session(SessionError::Fault(fault))) = error else {
         panic!("{text}")
     };
-    assert_eq!((node, actuator.as_deref()), (2, Some("chest-l1")), "{text}");
-    assert!(text.contains("FollowingError") || text.contains("FOLLOWING"), "{text}");
+    assert_eq!((fault.node.address, fault.actuator.as_deref()), (2, Some("chest-l1")), "{text}");
+    assert!(text.contains("following error of"), "{text}");
+    assert!(!text.contains("Some(") && !text.contains("Faults("), "{text}");
+}
+
+#[tokio::test(start_paused = true)]
+async fn a_stall_during_homing_is_reported_at_once_naming_the_actuator() {
+    let form = reference();
+    let setpoints = full_form_setpoints(&form);
+    // Jammed from the start: homing lags 1 mm (FollowingErrorLimit) after 0.2 s at 5 mm/s.
+    let config = config(CanKind::CLASSIC_1M, "chest-l1:stall@0s");
+    let start = Instant::now();
+    let error = drive_on_sim(&form, &setpoints, &DriveOptions::default(), &config, |_| {})
+        .await
+        .unwrap_err();
+    let reported = start.elapsed();
+    let text = error.to_string();
+    let SimDriveError::Drive(DriveError::Session(SessionError::Fault(fault))) = error else {
+        panic!("{text}")
+    };
+    assert_eq!(fault.actuator.as_deref(), Some("chest-l1"), "{text}");
+    assert!(text.starts_with("fault on node 2 (chest), actuator chest-l1: following error"));
+    // Discovery and enabling take a few hundred ms, the jam shows 0.2 s into homing: the
+    // report follows within a second of the latch (the homing timeout is 30 s).
+    assert!(reported < Duration::from_secs(1), "{reported:?}");
 }
 
 #[tokio::test(start_paused = true)]
@@ -158,7 +181,7 @@ async fn an_emergency_stop_reaches_every_node() {
     let bus = CanBus::new(CanKind::CLASSIC_1M);
     let simulated =
         SimulatedForm::on_can(&form, &bus, &FaultSpec::default(), &SimOptions::default()).unwrap();
-    emergency_stop(SimBus::attach(&bus)).await.unwrap();
+    emergency_stop(&SimBus::attach(&bus)).unwrap();
     tokio::time::sleep(Duration::from_millis(10)).await;
     let truth = simulated.state();
     for node in &truth.nodes {
@@ -168,25 +191,33 @@ async fn an_emergency_stop_reaches_every_node() {
 }
 
 #[tokio::test(start_paused = true)]
-async fn a_stop_request_during_a_move_sends_an_emergency_stop() {
+async fn an_emergency_stop_from_another_thread_ends_the_move_and_nothing_follows_it() {
     let form = reference();
     let setpoints = full_form_setpoints(&form);
     let bus = CanBus::new(CanKind::CLASSIC_1M);
     let simulated =
         SimulatedForm::on_can(&form, &bus, &FaultSpec::default(), &SimOptions::default()).unwrap();
-    let (stop, stopped) = tokio::sync::watch::channel(false);
-    let options = DriveOptions { stop: Some(stopped), ..DriveOptions::default() };
+    let link = SimBus::attach(&bus);
+    let gate = link.gate().clone();
+    // Mid-move (discovery and homing take about 1.2 s), from a thread of its own as the
+    // control endpoint and the signal thread do.
     tokio::spawn(async move {
         tokio::time::sleep(Duration::from_millis(2500)).await;
-        stop.send(true).unwrap();
+        std::thread::spawn(move || gate.emergency_stop(StopCause::Remote).unwrap()).join().unwrap();
     });
+    let options = DriveOptions::default();
     let error =
-        dressform::controller::drive(SimBus::attach(&bus), &form, &setpoints, &options, |_| {})
-            .await
-            .unwrap_err();
-    assert!(matches!(error, DriveError::Session(SessionError::Interrupted)), "{error}");
-    tokio::time::sleep(Duration::from_millis(10)).await;
-    assert!(simulated.state().nodes.iter().all(|n| n.faults.contains(Faults::EMERGENCY_STOP)));
+        dressform::controller::drive(link, &form, &setpoints, &options, |_| {}).await.unwrap_err();
+    assert!(
+        matches!(error, DriveError::Session(SessionError::Stopped(StopCause::Remote))),
+        "{error}"
+    );
+    assert!(error.to_string().contains("an e-stop from another terminal"), "{error}");
+    // The nodes stay stopped: nothing (no FaultReset, no Enable) followed the stop.
+    tokio::time::sleep(Duration::from_millis(1000)).await;
+    let truth = simulated.state();
+    assert!(truth.nodes.iter().all(|n| n.faults.contains(Faults::EMERGENCY_STOP)), "{truth:?}");
+    assert!(truth.actuators.iter().all(|a| !a.state.moving), "{truth:?}");
 }
 
 #[tokio::test(start_paused = true)]

@@ -226,15 +226,15 @@ fn measure_and_slice_json() {
         dressform(&["measure", base.to_str().unwrap(), "--json", "--at", "1000,2000"]);
     assert_eq!(code, 0, "{stderr}");
     let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
-    let crotch = v["measurements"]["crotch_height"].as_f64().unwrap();
+    let crotch = v["measurements"]["crotch_height_mm"].as_f64().unwrap();
     assert!((700.0..850.0).contains(&crotch), "crotch {crotch}");
     let (chest, waist, hip) = (
-        v["measurements"]["chest"]["tape"].as_f64().unwrap(),
-        v["measurements"]["waist"]["tape"].as_f64().unwrap(),
-        v["measurements"]["hip"]["tape"].as_f64().unwrap(),
+        v["measurements"]["chest"]["tape_mm"].as_f64().unwrap(),
+        v["measurements"]["waist"]["tape_mm"].as_f64().unwrap(),
+        v["measurements"]["hip"]["tape_mm"].as_f64().unwrap(),
     );
     assert!(waist < chest && waist < hip, "{chest} {waist} {hip}");
-    assert!(v["at"][0]["tape"].as_f64().unwrap() > 0.0);
+    assert!(v["at"][0]["tape_mm"].as_f64().unwrap() > 0.0);
     assert!(v["at"][1].is_null(), "no torso above the head");
 
     let (code, stdout, stderr) =

@@ -12,7 +12,11 @@ use sim::form::reference;
 use sim::serve::{ServeConfig, Transport, serve};
 
 fn scan_file(dir: &std::path::Path) -> std::path::PathBuf {
-    let body = generate(&BodyParams::default()).unwrap();
+    scan_of(dir, &BodyParams::default())
+}
+
+fn scan_of(dir: &std::path::Path, params: &BodyParams) -> std::path::PathBuf {
+    let body = generate(params).unwrap();
     let raw = capture(&body, &Artifacts::typical_scanner(2));
     let mesh =
         Mesh::new(raw.positions.iter().map(|&p| DVec3::from_array(p)).collect(), raw.triangles);
@@ -68,4 +72,40 @@ fn run_shapes_the_form_over_a_serial_pty() {
 #[test]
 fn run_shapes_the_form_over_slcan() {
     run_over(Transport::SlcanPty, "--slcan");
+}
+
+/// A slim customer: the reference form's waist is 695 mm at its smallest; the run drives the
+/// form as close as it goes and exits 3, naming the rings it could not reach and by how much.
+#[test]
+fn run_on_a_customer_the_form_cannot_reach_exits_3_naming_the_rings() {
+    let tmp = tempfile::tempdir().unwrap();
+    let slim = BodyParams {
+        chest_girth_mm: 860.0,
+        waist_girth_mm: 625.0,
+        hip_girth_mm: 900.0,
+        ..BodyParams::default()
+    };
+    let scan = scan_of(tmp.path(), &slim);
+    let out = tmp.path().join("out");
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_dressform"))
+        .args(["run", scan.to_str().unwrap(), "--sim", "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let (stdout, stderr) =
+        (String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
+    assert_eq!(output.status.code(), Some(3), "{stdout}\n{stderr}");
+    let summary =
+        stderr.lines().find(|l| l.starts_with("error: the form could not take the shape"));
+    let summary = summary.unwrap_or_else(|| panic!("{stderr}"));
+    // The waist: the mannequin's girth (about 625 mm) against the form's smallest (695 mm).
+    let waist = summary.split(", ").find(|r| r.contains("waist not reached by"));
+    let waist = waist.unwrap_or_else(|| panic!("{summary}"));
+    let mm: f64 =
+        waist.split("not reached by ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!((50.0..=90.0).contains(&mm), "{waist}");
+    // Every ring in the table has a status; the waist's is the same as in the summary.
+    let row = stdout.lines().rev().find(|l| l.trim_start().starts_with("waist")).unwrap();
+    assert!(row.contains(&format!("not reached by {mm:.0} mm")), "{row}");
+    // Notes below 1 mm are not listed.
+    assert!(!stdout.contains(" 0.1 mm") && !stdout.contains(" 0.0 mm"), "{stdout}");
 }

@@ -4,19 +4,12 @@
 
 use crate::common;
 
-use common::makehuman;
+use common::{makehuman, mesh_of};
 use dressform::mesh::Mesh;
 use dressform::regions::{Armhole, BodyRegions, TRACKING_STEP_MM};
 use dressform::scan::{self, frame::FrameOptions};
 use glam::DVec3;
-use sim::capture::{BodyParams, Pose, SyntheticBody, generate};
-
-fn mesh_of(body: &SyntheticBody) -> Mesh {
-    Mesh::new(
-        body.surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
-        body.surface.triangles.clone(),
-    )
-}
+use sim::capture::{BodyParams, Pose, generate};
 
 /// Spacing of the torso sections compared for the width jump (the mannequin's own rule).
 const JUMP_STEP_MM: f64 = 2.0;
@@ -235,4 +228,39 @@ fn armholes_of_the_makehuman_body_are_mirror_images() {
     );
     assert!(shape.jump.0 <= SMOOTH_JUMP_MM);
     assert!(shape.reach[0] <= l.shoulder_point.x - m.centre_x + 1e-6);
+}
+
+#[test]
+fn slice_labels_the_untouched_makehuman_body() {
+    let Some(dir) = makehuman() else { return };
+    let base = dir.join("base.obj");
+    let (code, stdout, stderr) = common::dressform(&[
+        "slice",
+        base.to_str().unwrap(),
+        "--smooth",
+        "0",
+        "--json",
+        "--heights",
+        "300,900,1100,1620",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let out: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    // Per plane, the labels expected (left is +x): legs, torso, torso and both arms, head.
+    let expected: [&[&str]; 4] =
+        [&["left_leg", "right_leg"], &["torso"], &["left_arm", "right_arm", "torso"], &["head"]];
+    for (section, want) in out["sections"].as_array().unwrap().iter().zip(expected) {
+        let loops = section["loops"].as_array().unwrap();
+        let mut labels: Vec<&str> = loops.iter().map(|l| l["label"].as_str().unwrap()).collect();
+        for l in loops {
+            let x = l["centroid_mm"][0].as_f64().unwrap();
+            match l["label"].as_str().unwrap() {
+                "left_leg" | "left_arm" => assert!(x > 50.0, "{l}"),
+                "right_leg" | "right_arm" => assert!(x < -50.0, "{l}"),
+                _ => assert!(x.abs() < 30.0, "{l}"),
+            }
+        }
+        labels.sort_unstable();
+        labels.dedup();
+        assert_eq!(labels, want, "at z = {}", section["z_mm"]);
+    }
 }

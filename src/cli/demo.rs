@@ -4,10 +4,11 @@
 //! mannequin, fit the reference form and drive the simulated form over the in-process bus —
 //! then compare the customer's true girths with the scan's and the mannequin's.
 
-use super::drive::SimArgs;
-use super::run::shape_form;
+use super::drive::{SimArgs, shape_verdict};
+use super::run::{Drive, shape_form};
 use super::{Failure, progress_bar};
-use dressform::controller::LinkSpec;
+use dressform::controller::{DriveOptions, LinkSpec};
+use dressform::fitting::DEFAULT_GIRTH_TOLERANCE_MM;
 use dressform::mesh::{Mesh, smooth::DEFAULT_PASSES};
 use dressform::output::write_atomically;
 use dressform::report::ScanInfo;
@@ -66,8 +67,13 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
     );
     out!("{info}");
     outln!();
-    let result =
-        shape_form(&scan, &sim::form::reference(), &LinkSpec::Sim, &SimArgs::default(), &args.out)?;
+    let drive = Drive {
+        link: &LinkSpec::Sim,
+        sim: &SimArgs::default(),
+        options: &DriveOptions::default(),
+        girth_tolerance: DEFAULT_GIRTH_TOLERANCE_MM,
+    };
+    let (result, shape) = shape_form(&scan, &sim::form::reference(), &drive, &args.out)?;
     outln!();
     outln!("  {:<12} {:>9} {:>9} {:>11}", "measure (mm)", "customer", "scan", "mannequin");
     let c = &result.comparison;
@@ -86,5 +92,5 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         "Written to {}: scan.ply, mannequin.obj, profiles.json, measurements.json, setpoints.json, preview.png (a picture of the scan and the mannequin), sections.svg",
         args.out.display()
     );
-    Ok(())
+    shape_verdict(&shape)
 }

@@ -1,65 +1,23 @@
 //! `dressform drive <setpoints.json> [--form <form.toml>] (--sim | --serial <path> |
 //! --slcan <path> | --can <iface>) [--log <file>] [--faults <spec>] [--clamp]
-//! [--tolerance <mm>] [--slower <factor>] [--duration <s>] [--json]`.
+//! [--tolerance <mm>] [--girth-tolerance <mm>] [--reset-faults] [--slower <factor>]
+//! [--duration <s>] [--json]`.
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Duration;
 
-use dressform::controller::simulated::{SimConfig, drive_on_sim};
+use dressform::controller::simulated::SimConfig;
 use dressform::controller::{
-    Connection, DEFAULT_TOLERANCE_MM, DriveError, DriveOptions, DriveReport, LinkSpec, Progress,
+    DEFAULT_TOLERANCE_MM, DriveError, DriveOptions, DriveReport, LinkSpec, Progress, SessionError,
     drive, plan,
 };
+use dressform::fitting::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
 use dressform::setpoints::SetPoints;
 use sim::form::FormDescription;
 
 use super::Failure;
-
-/// Where the form is.
-#[derive(Debug, Clone, clap::Args)]
-#[group(required = true, multiple = false)]
-pub struct LinkArgs {
-    /// The in-process simulated form (no hardware needed).
-    #[arg(long)]
-    sim: bool,
-    /// A serial port speaking the protocol's serial mapping (1 Mbaud).
-    #[arg(long, value_name = "PATH")]
-    serial: Option<PathBuf>,
-    /// An slcan (Lawicel) USB-CAN adapter on a serial port (classic CAN, 1 Mbit/s).
-    #[arg(long, value_name = "PATH")]
-    slcan: Option<PathBuf>,
-    /// A SocketCAN interface (can0, vcan0...).
-    #[arg(long, value_name = "IFACE")]
-    can: Option<String>,
-}
-
-impl LinkArgs {
-    pub fn spec(&self) -> LinkSpec {
-        match (&self.serial, &self.slcan, &self.can) {
-            (Some(path), _, _) => LinkSpec::Serial(path.clone()),
-            (_, Some(path), _) => LinkSpec::Slcan(path.clone()),
-            (_, _, Some(iface)) => LinkSpec::Can(iface.clone()),
-            _ => LinkSpec::Sim,
-        }
-    }
-}
-
-/// Loads `--form`, or the built-in reference form.
-pub fn load_form(path: Option<&PathBuf>) -> Result<FormDescription, Failure> {
-    match path {
-        Some(path) => FormDescription::load(path).map_err(Failure::bad_input),
-        None => Ok(sim::form::reference()),
-    }
-}
-
-/// A current-thread runtime for one command.
-pub fn runtime() -> Result<tokio::runtime::Runtime, Failure> {
-    tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .map_err(|e| Failure::other(format!("cannot start the runtime: {e}")))
-}
+use super::link::{self, FormArg, LinkArgs, runtime};
 
 /// The simulated form's options (with `--sim`).
 #[derive(Debug, Clone, Default, clap::Args)]
@@ -72,17 +30,47 @@ pub struct SimArgs {
     faults: Option<String>,
 }
 
+/// How the form's shape is judged after a move.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ShapeArgs {
+    /// A ring whose reached girth is off the mannequin's by more than this is "not reached"
+    /// and the command exits 3, mm.
+    #[arg(long, value_name = "MM", default_value_t = DEFAULT_GIRTH_TOLERANCE_MM)]
+    girth_tolerance: f64,
+    /// Clear latched hardware faults (a jam, an overcurrent, a broken encoder...) before
+    /// moving; without it only an e-stop and a host timeout are cleared.
+    #[arg(long)]
+    reset_faults: bool,
+}
+
+impl ShapeArgs {
+    /// The tolerance, checked.
+    pub fn girth_tolerance(&self) -> Result<f64, Failure> {
+        if self.girth_tolerance.is_finite() && self.girth_tolerance >= 0.0 {
+            Ok(self.girth_tolerance)
+        } else {
+            Err(Failure::bad_input("--girth-tolerance: must be a number of mm, 0 or more"))
+        }
+    }
+
+    /// Drive options with `--reset-faults`.
+    pub fn options(&self) -> DriveOptions {
+        DriveOptions { reset_faults: self.reset_faults, ..DriveOptions::default() }
+    }
+}
+
 #[derive(Debug, clap::Args)]
 pub struct DriveArgs {
     /// The set-point file (JSON, format dressform-setpoints/1).
     setpoints: PathBuf,
-    /// The form description (TOML) [default: the built-in reference form].
-    #[arg(long)]
-    form: Option<PathBuf>,
+    #[command(flatten)]
+    form: FormArg,
     #[command(flatten)]
     link: LinkArgs,
     #[command(flatten)]
     sim: SimArgs,
+    #[command(flatten)]
+    shape: ShapeArgs,
     /// Clamp positions outside an actuator's stroke into it (reported) instead of refusing
     /// the file.
     #[arg(long)]
@@ -102,7 +90,7 @@ pub struct DriveArgs {
 }
 
 pub fn run(args: &DriveArgs) -> Result<(), Failure> {
-    let form = load_form(args.form.as_ref())?;
+    let form = args.form.load()?;
     let setpoints = SetPoints::load(&args.setpoints, &form).map_err(Failure::bad_input)?;
     let file = args.setpoints.display().to_string();
     // Refuse out-of-stroke files before touching the form.
@@ -118,20 +106,33 @@ pub fn run(args: &DriveArgs) -> Result<(), Failure> {
         Some(_) => return Err(Failure::bad_input("--duration: must be 0..=65.535 seconds")),
         None => Duration::ZERO,
     };
+    let girth_tolerance = args.shape.girth_tolerance()?;
     let options = DriveOptions {
         clamp: args.clamp,
         tolerance_mm: args.tolerance,
         slower: args.slower,
         min_duration,
-        ..DriveOptions::default()
+        ..args.shape.options()
     };
     let report = execute(&form, &setpoints, &args.link.spec(), &options, &args.sim, args.json)?;
-    print_report(&report, args.json)
+    let shape = compare(&form, &report.positions_mm, &setpoints.target_girths_mm, girth_tolerance);
+    print_report(&report, &shape, args.json)?;
+    shape_verdict(&shape)
+}
+
+/// Exit status 3 with a one-line summary when a ring is off its girth by more than the
+/// tolerance: the form could not take the shape.
+pub fn shape_verdict(shape: &ShapeOutcome) -> Result<(), Failure> {
+    match shape.summary() {
+        Some(summary) => Err(Failure { message: summary, exit_code: 3 }),
+        None => Ok(()),
+    }
 }
 
 /// Drives `form` to `setpoints` over `link` (the in-process simulated form for
 /// [`LinkSpec::Sim`], with `sim`'s log and faults), with one progress bar per node (none with
-/// `json`); Ctrl-C broadcasts an emergency stop.
+/// `json`); signals and `dressform estop` from another terminal e-stop the form. A failing
+/// log is reported when it fails, and fails the command once the move is over.
 pub fn execute(
     form: &FormDescription,
     setpoints: &SetPoints,
@@ -144,40 +145,51 @@ pub fn execute(
         return Err(Failure::bad_input("--log and --faults go with --sim"));
     }
     let faults = match &sim.faults {
-        Some(text) => text.parse().map_err(Failure::bad_input)?,
+        Some(text) => text.parse().map_err(|e| Failure::bad_input(format!("--faults: {e}")))?,
         None => Default::default(),
     };
-    let (stop_tx, stop) = tokio::sync::watch::channel(false);
-    let options = DriveOptions { stop: Some(stop), ..options.clone() };
     let display = ProgressDisplay::new(json);
     let progress = |p: &Progress| display.update(p);
     let runtime = runtime()?;
     let result = runtime.block_on(async {
-        tokio::spawn(async move {
-            if tokio::signal::ctrl_c().await.is_ok() {
-                let _ = stop_tx.send(true);
-            }
-        });
         match link {
             LinkSpec::Sim => {
                 let config = SimConfig { faults, log: sim.log.clone(), ..SimConfig::default() };
-                drive_on_sim(form, setpoints, &options, &config, progress)
-                    .await
-                    .map(|(report, _)| report)
-                    .map_err(|e| match e {
-                        dressform::controller::simulated::SimDriveError::Drive(d) => d.into(),
-                        other => Failure::bad_input(other),
-                    })
+                let rig = link::simulated(form, &config)?;
+                let transport = rig.attach();
+                let _armed = link::arm(&transport);
+                let driving = drive(transport, form, setpoints, options, progress);
+                // The log's health, watched while the form moves.
+                let log_watch = async {
+                    loop {
+                        tokio::time::sleep(LOG_CHECK).await;
+                        if let Some(e) = rig.log_failure() {
+                            errln!("error: {e} (the move goes on)");
+                            std::future::pending::<()>().await;
+                        }
+                    }
+                };
+                let report = tokio::select! {
+                    report = driving => report,
+                    () = log_watch => unreachable!("the log watch never ends"),
+                };
+                rig.finish().map_err(link::sim_failure)?;
+                report.map_err(Failure::from)
             }
             spec => {
-                let connection = Connection::open(spec).map_err(Failure::other)?;
-                drive(connection, form, setpoints, &options, progress).await.map_err(Into::into)
+                let owned = link::own(spec)?;
+                drive(owned.connection, form, setpoints, options, progress)
+                    .await
+                    .map_err(Into::into)
             }
         }
     });
     display.finish();
     result
 }
+
+/// How often a simulated bus's log is checked for write errors.
+const LOG_CHECK: Duration = Duration::from_millis(100);
 
 impl From<DriveError> for Failure {
     fn from(e: DriveError) -> Self {
@@ -187,12 +199,15 @@ impl From<DriveError> for Failure {
                 print_table(&report);
                 Failure::other(DriveError::NotReached(report))
             }
+            DriveError::Session(SessionError::Latched(_)) => Failure::other(format!(
+                "{e}\ncheck the form, then clear them with `dressform reset` (or drive with --reset-faults)"
+            )),
             e => Failure::other(e),
         }
     }
 }
 
-fn print_report(report: &DriveReport, json: bool) -> Result<(), Failure> {
+fn print_report(report: &DriveReport, shape: &ShapeOutcome, json: bool) -> Result<(), Failure> {
     for (id, asked, used) in &report.clamped {
         errln!("warning: {id}: {asked} mm is outside the stroke, clamped to {used} mm");
     }
@@ -200,10 +215,26 @@ fn print_report(report: &DriveReport, json: bool) -> Result<(), Failure> {
         errln!("warning: {warning}");
     }
     if json {
-        let text = serde_json::to_string_pretty(report).map_err(Failure::other)?;
+        // The report, with the shape beside its fields.
+        let mut value = serde_json::to_value(report).map_err(Failure::other)?;
+        value["shape"] = serde_json::to_value(shape).map_err(Failure::other)?;
+        let text = serde_json::to_string_pretty(&value).map_err(Failure::other)?;
         outln!("{text}");
     } else {
         print_table(report);
+        if !shape.rings.is_empty() {
+            outln!("{:<12} {:>10} {:>10} {:>8}  status", "ring", "mannequin", "form", "error");
+            for r in &shape.rings {
+                outln!(
+                    "{:<12} {:>10.1} {:>10.1} {:>8.1}  {}",
+                    r.ring,
+                    r.target_mm,
+                    r.reached_mm,
+                    r.error_mm(),
+                    shape.status(r)
+                );
+            }
+        }
     }
     Ok(())
 }

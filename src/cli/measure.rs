@@ -1,22 +1,30 @@
-//! `dressform measure <mesh> [--json] [--at z,...]`.
+//! `dressform measure <mesh or directory>... [--json | --csv] [--at z,...]`: one scan, or
+//! several measured in parallel (one row each).
 
 use super::{Failure, FrameArgs, SmoothArgs, warn};
-use dressform::measure::{Girth, Levels, Measurements, levels, measure_at};
+use dressform::measure::{
+    BodyDimensions, Girth, Levels, Measurements, dimensions, levels, measure_at, warnings,
+};
 use dressform::regions::{BodyRegions, Landmarks, TRACKING_STEP_MM};
 use dressform::scan;
+use rayon::prelude::*;
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]
 pub struct MeasureArgs {
-    /// The body: an .obj, .ply or .stl file.
-    mesh: PathBuf,
+    /// The bodies: .obj, .ply or .stl files, or directories of them.
+    #[arg(required = true)]
+    meshes: Vec<PathBuf>,
     /// Also give the torso girth at these heights (mm above the floor), comma-separated.
     #[arg(long, value_delimiter = ',')]
     at: Vec<f64>,
-    /// Print JSON (documented in the README).
-    #[arg(long)]
+    /// Print JSON (documented in the README): an object, or an array for several scans.
+    #[arg(long, conflicts_with = "csv")]
     json: bool,
+    /// Print CSV for spreadsheets: a header line, then one row per scan.
+    #[arg(long)]
+    csv: bool,
     #[command(flatten)]
     frame: FrameArgs,
     #[command(flatten)]
@@ -29,15 +37,42 @@ struct MeasureOut {
     landmarks: Landmarks,
     levels: Levels,
     measurements: Measurements,
+    /// The ISO 8559-1 body dimensions.
+    dimensions: BodyDimensions,
     /// Torso girths at the requested heights (`null` where there is no torso).
     at: Vec<Option<Girth>>,
+    /// Where a number is unreliable.
+    warnings: Vec<String>,
 }
 
-pub fn run(args: &MeasureArgs) -> Result<(), Failure> {
-    if let Some(h) = args.at.iter().find(|h| !h.is_finite()) {
-        return Err(Failure::bad_input(format!("--at: {h} is not a height")));
+/// The scan files `paths` name: files as given, directories' .obj, .ply and .stl files.
+fn scan_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, Failure> {
+    let mut files = Vec::new();
+    for path in paths {
+        if !path.is_dir() {
+            files.push(path.clone());
+            continue;
+        }
+        let read = std::fs::read_dir(path)
+            .map_err(|e| Failure::bad_input(format!("{}: cannot read: {e}", path.display())))?;
+        let mut found: Vec<PathBuf> = read
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| scan::format::Format::from_path(p).is_some())
+            .collect();
+        if found.is_empty() {
+            return Err(Failure::bad_input(format!(
+                "{}: no .obj, .ply or .stl file in this directory",
+                path.display()
+            )));
+        }
+        found.sort();
+        files.extend(found);
     }
-    let mut scan = scan::load(&args.mesh, &args.frame.options()).map_err(Failure::bad_input)?;
+    Ok(files)
+}
+
+fn measure_one(path: &Path, args: &MeasureArgs) -> Result<MeasureOut, Failure> {
+    let mut scan = scan::load(path, &args.frame.options()).map_err(Failure::bad_input)?;
     scan.body.taubin_smooth(args.smooth.smooth);
     let file = scan.source.display().to_string();
     for w in scan.cleaning.warnings() {
@@ -47,30 +82,89 @@ pub fn run(args: &MeasureArgs) -> Result<(), Failure> {
         .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
     let levels = levels(&scan.body, &regions);
     let measurements = measure_at(&scan.body, &regions, &levels);
+    let dimensions = dimensions(&scan.body, &regions, &levels);
+    let warnings = warnings(&scan.body, &levels);
     let at = regions
         .torso_sections(&scan.body, &args.at)
         .into_iter()
         .zip(&args.at)
         .map(|(l, &z)| l.map(|c| Girth { z, tape: c.tape_girth(), contour: c.perimeter() }))
         .collect();
-    let out = MeasureOut { file, landmarks: regions.landmarks, levels, measurements, at };
-    if args.json {
-        outln!("{}", serde_json::to_string_pretty(&out).map_err(Failure::other)?);
-        return Ok(());
+    Ok(MeasureOut {
+        file,
+        landmarks: regions.landmarks,
+        levels,
+        measurements,
+        dimensions,
+        at,
+        warnings,
+    })
+}
+
+/// The scalar fields of a JSON object, flattened to `a.b` names, in order.
+fn flatten(prefix: &str, v: &serde_json::Value, out: &mut Vec<(String, String)>) {
+    match v {
+        serde_json::Value::Object(map) => {
+            for (k, v) in map {
+                let name = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+                flatten(&name, v, out);
+            }
+        }
+        serde_json::Value::Number(n) => {
+            let x = n.as_f64().unwrap_or(f64::NAN);
+            out.push((prefix.to_string(), format!("{x:.1}")));
+        }
+        _ => {}
     }
-    let m = &out.measurements;
-    outln!("{}", out.file);
-    outln!("  height          {:7.1} mm", m.height);
-    outln!("  crotch height   {:7.1} mm", m.crotch_height);
-    for (name, g) in [("chest", m.chest), ("waist", m.waist), ("hip", m.hip)] {
+}
+
+/// One CSV row of a scan: its file and every dimension.
+fn csv_row(m: &MeasureOut) -> Result<Vec<(String, String)>, Failure> {
+    let mut row = vec![("file".to_string(), format!("\"{}\"", m.file.replace('"', "\"\"")))];
+    let dims = serde_json::to_value(&m.dimensions).map_err(Failure::other)?;
+    flatten("", &dims, &mut row);
+    Ok(row)
+}
+
+fn print_text(m: &MeasureOut, at: &[f64]) {
+    let d = &m.dimensions;
+    outln!("{}", m.file);
+    let g = |name: &str, v: f64| outln!("  {name:<22} {v:7.1} mm");
+    let b = |name: &str, v: &dressform::measure::Bilateral, unit: &str| {
         outln!(
-            "  {name:<6} girth    {:7.1} mm at z = {:.0} mm (contour {:.1} mm)",
-            g.tape,
-            g.z,
-            g.contour
+            "  {name:<22} {:7.1} {unit} left, {:7.1} {unit} right ({:+.1})",
+            v.left,
+            v.right,
+            v.difference
+        )
+    };
+    g("stature", d.stature_mm);
+    g("neck girth", d.neck_girth_mm);
+    g("shoulder width", d.shoulder_width_mm);
+    b("shoulder slope", &d.shoulder_slope_deg, "deg");
+    for (name, girth) in [
+        ("chest", m.measurements.chest),
+        ("waist", m.measurements.waist),
+        ("hip", m.measurements.hip),
+    ] {
+        outln!(
+            "  {:<22} {:7.1} mm at z = {:.0} mm (contour {:.1} mm)",
+            format!("{name} girth"),
+            girth.tape,
+            girth.z,
+            girth.contour
         );
     }
-    for (z, g) in args.at.iter().zip(&out.at) {
+    g("underbust girth", d.underbust_girth_mm);
+    g("high hip girth", d.high_hip_girth_mm);
+    b("thigh girth", &d.thigh_girth_mm, "mm");
+    b("knee girth", &d.knee_girth_mm, "mm");
+    b("calf girth", &d.calf_girth_mm, "mm");
+    b("ankle girth", &d.ankle_girth_mm, "mm");
+    g("inside leg", d.inside_leg_mm);
+    g("back waist length", d.back_waist_length_mm);
+    g("front waist length", d.front_waist_length_mm);
+    for (z, g) in at.iter().zip(&m.at) {
         match g {
             Some(g) => {
                 outln!("  torso at {z:.0} mm  {:7.1} mm (contour {:.1} mm)", g.tape, g.contour)
@@ -78,5 +172,59 @@ pub fn run(args: &MeasureArgs) -> Result<(), Failure> {
             None => outln!("  torso at {z:.0} mm  none"),
         }
     }
-    Ok(())
+}
+
+pub fn run(args: &MeasureArgs) -> Result<(), Failure> {
+    if let Some(h) = args.at.iter().find(|h| !h.is_finite()) {
+        return Err(Failure::bad_input(format!("--at: {h} is not a height")));
+    }
+    let files = scan_files(&args.meshes)?;
+    let results: Vec<Result<MeasureOut, Failure>> =
+        files.par_iter().map(|f| measure_one(f, args)).collect();
+    // Every scan is measured; the first that failed decides the exit status.
+    let mut done = Vec::with_capacity(results.len());
+    let mut failed = Vec::new();
+    for r in results {
+        match r {
+            Ok(m) => done.push(m),
+            Err(e) if files.len() == 1 => return Err(e),
+            Err(e) => {
+                errln!("error: {}", e.message);
+                failed.push(e.exit_code);
+            }
+        }
+    }
+    for m in &done {
+        for w in &m.warnings {
+            warn(&m.file, w);
+        }
+    }
+    if args.json {
+        let text = if files.len() == 1 {
+            serde_json::to_string_pretty(&done[0])
+        } else {
+            serde_json::to_string_pretty(&done)
+        };
+        outln!("{}", text.map_err(Failure::other)?);
+    } else if args.csv {
+        let rows: Vec<Vec<(String, String)>> =
+            done.iter().map(csv_row).collect::<Result<_, _>>()?;
+        if let Some(first) = rows.first() {
+            outln!("{}", first.iter().map(|(k, _)| k.as_str()).collect::<Vec<_>>().join(","));
+        }
+        for row in &rows {
+            outln!("{}", row.iter().map(|(_, v)| v.as_str()).collect::<Vec<_>>().join(","));
+        }
+    } else {
+        for m in &done {
+            print_text(m, &args.at);
+        }
+    }
+    match failed.first() {
+        None => Ok(()),
+        Some(&exit_code) => Err(Failure {
+            message: format!("{} of {} scans could not be measured", failed.len(), files.len()),
+            exit_code,
+        }),
+    }
 }

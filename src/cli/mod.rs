@@ -28,10 +28,14 @@ macro_rules! errln {
 mod demo;
 mod drive;
 mod estop;
+mod form;
 mod info;
+mod link;
 mod measure;
+mod reset;
 mod run;
 mod setpoints;
+mod signals;
 mod sim;
 mod slice;
 mod status;
@@ -72,8 +76,12 @@ enum Command {
     Drive(drive::DriveArgs),
     /// Show every node of the robotic form: identity, state, faults, positions.
     Status(status::StatusArgs),
-    /// Broadcast an emergency stop to every node of the robotic form.
+    /// Broadcast an emergency stop to every node of the robotic form, from any terminal.
     Estop(estop::EstopArgs),
+    /// Clear the latched faults of every node (FaultReset), saying what each held.
+    Reset(reset::ResetArgs),
+    /// The robotic form's description: `form show [--toml]`.
+    Form(form::FormArgs),
 }
 
 /// How the scan's frame is given on the command line (all optional: detected by default).
@@ -138,6 +146,8 @@ pub fn run(args: Args) -> Result<(), Failure> {
         Command::Drive(a) => drive::run(&a),
         Command::Status(a) => status::run(&a),
         Command::Estop(a) => estop::run(&a),
+        Command::Reset(a) => reset::run(&a),
+        Command::Form(a) => form::run(&a),
     }
 }
 

@@ -1,13 +1,15 @@
 //! `dressform run <scan> [--form <form.toml>] (--sim | --serial <path> | --slcan <path> |
-//! --can <iface>) [--out <dir>]`: scan to shaped form in one command — the symmetric
-//! mannequin, the set-points that give the form its shape, the drive — and a final report
-//! comparing the scan's, the mannequin's and the form's girths at every ring.
+//! --can <iface>) [--out <dir>] [--girth-tolerance <mm>] [--reset-faults]`: scan to shaped
+//! form in one command — the symmetric mannequin, the set-points that give the form its
+//! shape, the drive — and a final report comparing the scan's, the mannequin's and the form's
+//! girths at every ring. Exit status 3 when a ring did not reach the mannequin's girth.
 
-use super::drive::{LinkArgs, SimArgs, execute, load_form};
-use super::setpoints::fidelity_table;
+use super::drive::{ShapeArgs, SimArgs, execute, shape_verdict};
+use super::link::{FormArg, LinkArgs};
+use super::setpoints::{fidelity_table, setpoints_of};
 use super::{Failure, FrameArgs, SmoothArgs, progress_bar, warn};
-use dressform::controller::{DriveOptions, DriveReport, LinkSpec};
-use dressform::fitting::{Fit, fit, region_of, ring_girth};
+use dressform::controller::{DriveOptions, LinkSpec};
+use dressform::fitting::{Fit, ShapeOutcome, compare, fit, region_of};
 use dressform::mannequin::MannequinOptions;
 use dressform::mesh::topology;
 use dressform::output::write_atomically;
@@ -25,13 +27,14 @@ use std::path::{Path, PathBuf};
 pub struct RunArgs {
     /// The scan: an .obj, .ply or .stl file.
     scan: PathBuf,
-    /// The form description (TOML) [default: the built-in reference form].
-    #[arg(long)]
-    form: Option<PathBuf>,
+    #[command(flatten)]
+    form: FormArg,
     #[command(flatten)]
     link: LinkArgs,
     #[command(flatten)]
     sim: SimArgs,
+    #[command(flatten)]
+    shape: ShapeArgs,
     /// Where to write mannequin.obj, profiles.json, measurements.json, setpoints.json,
     /// preview.png and sections.svg.
     #[arg(long, default_value = "dressform-run")]
@@ -43,25 +46,42 @@ pub struct RunArgs {
 }
 
 pub fn run(args: &RunArgs) -> Result<(), Failure> {
-    let form = load_form(args.form.as_ref())?;
+    let form = args.form.load()?;
+    let girth_tolerance = args.shape.girth_tolerance()?;
     let mut scan = scan::load(&args.scan, &args.frame.options()).map_err(Failure::bad_input)?;
     let file = scan.source.display().to_string();
     for w in scan.cleaning.warnings().into_iter().chain(topology(&scan.body).warnings()) {
         warn(&file, &w);
     }
     scan.body.taubin_smooth(args.smooth.smooth);
-    shape_form(&scan, &form, &args.link.spec(), &args.sim, &args.out).map(|_| ())
+    let link = args.link.spec();
+    let drive =
+        Drive { link: &link, sim: &args.sim, options: &args.shape.options(), girth_tolerance };
+    let (_, shape) = shape_form(&scan, &form, &drive, &args.out)?;
+    shape_verdict(&shape)
+}
+
+/// How `run` and `demo` drive the form.
+pub struct Drive<'a> {
+    /// Where the form is.
+    pub link: &'a LinkSpec,
+    /// The simulated form's log and faults.
+    pub sim: &'a SimArgs,
+    /// The drive's options.
+    pub options: &'a DriveOptions,
+    /// A ring off the mannequin's girth by more than this is not reached, mm.
+    pub girth_tolerance: f64,
 }
 
 /// The chain shared by `run` and `demo`: mannequin, set-points, drive, report. Returns the
-/// mannequin and its measurements.
+/// mannequin and its measurements, and how well the form took the shape (the caller exits
+/// 3 when it did not).
 pub fn shape_form(
     scan: &Scan,
     form: &FormDescription,
-    link: &LinkSpec,
-    sim: &SimArgs,
+    drive: &Drive,
     out: &Path,
-) -> Result<Symmetrized, Failure> {
+) -> Result<(Symmetrized, ShapeOutcome), Failure> {
     let file = scan.source.display().to_string();
     let bar = progress_bar(false, STEPS.len() as u64 + 1);
     let result = symmetrize(scan, &MannequinOptions::default(), |step| {
@@ -72,7 +92,7 @@ pub fn shape_form(
     bar.set_message("fitting the form");
     let profiles = Profiles::of(&result.mannequin, &result.comparison.levels);
     let fitted = fit(&profiles, form).map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
-    let setpoints = SetPoints::new(form.name.clone(), fitted.positions_mm.clone());
+    let setpoints = setpoints_of(&fitted);
     write_outputs(out, scan, &result, &profiles, &setpoints)?;
     bar.finish_and_clear();
 
@@ -80,22 +100,27 @@ pub fn shape_form(
     outln!("Fit of form \"{}\" (ring heights on the form and on the body):", form.name);
     out!("{}", fidelity_table(&fitted));
     outln!();
-    let report = execute(form, &setpoints, link, &DriveOptions::default(), sim, false)?;
+    let report = execute(form, &setpoints, drive.link, drive.options, drive.sim, false)?;
+    for warning in &report.warnings {
+        errln!("warning: {warning}");
+    }
+    let shape =
+        compare(form, &report.positions_mm, &setpoints.target_girths_mm, drive.girth_tolerance);
     outln!(
         "{} on {}: {} actuators moved together in {} ms; {}.",
         report.form,
         report.device,
         report.actuators.len(),
         report.duration_ms,
-        if report.converged() {
-            "every actuator reached its set-point"
+        if shape.summary().is_some() {
+            "every actuator reached its set-point, but the form could NOT take the shape"
         } else {
-            "some actuators did NOT arrive"
+            "every actuator reached its set-point and every ring the mannequin's girth"
         }
     );
     outln!();
-    out!("{}", girth_table(scan, &result, form, &fitted, &report));
-    Ok(result)
+    out!("{}", girth_table(scan, &result, form, &fitted, &shape));
+    Ok((result, shape))
 }
 
 fn write_outputs(
@@ -125,21 +150,20 @@ fn write_outputs(
 }
 
 /// Scan, mannequin and form girths at every ring: the scan's section where the ring shapes
-/// the body, the mannequin's there, and the form's skin at the positions reached.
+/// the body, the mannequin's there, and the form's skin at the positions reached, with the
+/// ring's status.
 fn girth_table(
     scan: &Scan,
     result: &Symmetrized,
     form: &FormDescription,
     fitted: &Fit,
-    report: &DriveReport,
+    shape: &ShapeOutcome,
 ) -> String {
     use std::fmt::Write;
-    let reached: BTreeMap<String, f64> =
-        report.actuators.iter().filter_map(|a| a.reached_mm.map(|r| (a.id.clone(), r))).collect();
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "  {:<12} {:>9} {:>9} {:>11} {:>9}",
+        "  {:<12} {:>9} {:>9} {:>11} {:>9}  status",
         "girth (mm)", "body z", "scan", "mannequin", "form"
     );
     // The scan's sections: one sweep per region for all its rings.
@@ -163,14 +187,14 @@ fn girth_table(
     for (ring, r) in form.rings.iter().zip(&fitted.rings) {
         let z = r.mannequin_height_mm;
         let scanned = &scanned[&ring.name];
+        let (reached, status) = match shape.rings.iter().find(|o| o.ring == ring.name) {
+            Some(o) => (format!("{:.1}", o.reached_mm), shape.status(o)),
+            None => ("-".into(), "no body".into()),
+        };
         let _ = writeln!(
             s,
-            "  {:<12} {:>9.0} {:>9} {:>11.1} {:>9.1}",
-            ring.name,
-            z,
-            scanned,
-            r.mannequin_girth_mm,
-            ring_girth(form, ring, &reached)
+            "  {:<12} {:>9.0} {:>9} {:>11.1} {:>9}  {status}",
+            ring.name, z, scanned, r.mannequin_girth_mm, reached
         );
     }
     s

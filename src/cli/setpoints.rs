@@ -1,20 +1,21 @@
-//! `dressform setpoints <profiles.json> --form <form.toml> -o <setpoints.json> [--json]`: the
-//! actuator set-points that give the robotic form the mannequin's shape, and how well it fits.
+//! `dressform setpoints <profiles.json> [--form <form.toml>] -o <setpoints.json> [--json]`:
+//! the actuator set-points that give the robotic form the mannequin's shape, and how well it
+//! fits. The file records each ring's target girth, so `drive` can tell whether the form took
+//! the shape.
 
 use super::Failure;
-use dressform::fitting::{Fit, fit};
-use dressform::profiles::{self, Profiles};
+use super::link::FormArg;
+use dressform::fitting::{Fit, SHAPE_NOTE_MM, fit, regions_of};
+use dressform::profiles::Profiles;
 use dressform::setpoints::SetPoints;
-use sim::form::FormDescription;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
 pub struct SetpointsArgs {
     /// The mannequin's profiles.json (from `dressform symmetrize`).
     profiles: PathBuf,
-    /// The form description (TOML).
-    #[arg(long)]
-    form: PathBuf,
+    #[command(flatten)]
+    form: FormArg,
     /// Where to write the set-point file.
     #[arg(short, long)]
     out: PathBuf,
@@ -23,32 +24,13 @@ pub struct SetpointsArgs {
     json: bool,
 }
 
-/// Reads a profiles.json file.
-pub fn load_profiles(path: &Path) -> Result<Profiles, Failure> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| Failure::bad_input(format!("{}: cannot read: {e}", path.display())))?;
-    let p: Profiles = serde_json::from_slice(&bytes)
-        .map_err(|e| Failure::bad_input(format!("{}: not a profiles file: {e}", path.display())))?;
-    if p.format != profiles::FORMAT {
-        let message = format!(
-            "{}: format \"{}\", expected \"{}\"",
-            path.display(),
-            p.format,
-            profiles::FORMAT
-        );
-        return Err(Failure::bad_input(message));
-    }
-    Ok(p)
-}
-
 pub fn run(args: &SetpointsArgs) -> Result<(), Failure> {
-    let profiles = load_profiles(&args.profiles)?;
-    let form = FormDescription::load(&args.form).map_err(Failure::bad_input)?;
+    let form = args.form.load()?;
+    let profiles =
+        Profiles::load(&args.profiles, &regions_of(&form)).map_err(Failure::bad_input)?;
     let fitted = fit(&profiles, &form)
         .map_err(|e| Failure::bad_input(format!("{}: {e}", args.profiles.display())))?;
-    SetPoints::new(form.name.clone(), fitted.positions_mm.clone())
-        .save(&args.out)
-        .map_err(Failure::other)?;
+    setpoints_of(&fitted).save(&args.out).map_err(Failure::other)?;
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&fitted).map_err(Failure::other)?);
     } else {
@@ -58,41 +40,49 @@ pub fn run(args: &SetpointsArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The fidelity report as a table, with a line per saturated ring.
+/// The set-point file of a fit, with each ring's target girth.
+pub fn setpoints_of(fitted: &Fit) -> SetPoints {
+    SetPoints::new(fitted.form.clone(), fitted.positions_mm.clone())
+        .with_target_girths(fitted.target_girths())
+}
+
+/// The fidelity report as a table, with a line per ring whose shape or girth is limited.
 pub fn fidelity_table(fit: &Fit) -> String {
     use std::fmt::Write;
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "  {:<12} {:>8} {:>8} {:>11} {:>9} {:>9} {:>8}",
-        "ring", "form z", "body z", "mannequin", "form", "gap", "status"
+        "  {:<12} {:>8} {:>8} {:>11} {:>9} {:>9}  status",
+        "ring", "form z", "body z", "mannequin", "form", "gap"
     );
     for r in &fit.rings {
+        let excess = r.mannequin_girth_mm - r.form_girth_mm;
         let status = if r.mannequin_girth_mm == 0.0 {
-            "no body"
+            "no body".to_string()
+        } else if excess.abs() >= SHAPE_NOTE_MM {
+            format!("girth {excess:+.0} mm out of reach")
         } else if r.saturated.is_empty() {
-            "ok"
+            "ok".to_string()
         } else {
-            "limited"
+            "shape limited".to_string()
         };
         let _ = writeln!(
             s,
-            "  {:<12} {:>8.0} {:>8.0} {:>11.1} {:>9.1} {:>9.1} {:>8}",
+            "  {:<12} {:>8.0} {:>8.0} {:>11.1} {:>9.1} {:>9.1}  {status}",
             r.ring,
             r.form_height_mm,
             r.mannequin_height_mm,
             r.mannequin_girth_mm,
             r.form_girth_mm,
             r.largest_radial_gap_mm,
-            status
         );
     }
     let _ = writeln!(s, "  (girths and the largest radial gap between panel and mannequin, mm)");
     for r in fit.saturated() {
         let excess = r.mannequin_girth_mm - r.form_girth_mm;
-        let size = if excess > 0.5 {
+        let size = if excess >= SHAPE_NOTE_MM {
             format!("{excess:.0} mm of girth beyond the form's largest size")
-        } else if excess < -0.5 {
+        } else if excess <= -SHAPE_NOTE_MM {
             format!("{:.0} mm of girth below the form's smallest size", -excess)
         } else {
             "girth matched; shape limited".to_string()

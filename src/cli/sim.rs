@@ -1,8 +1,8 @@
-//! `dressform sim --form <form.toml> (--serial-pty | --slcan-pty) [--log <file>]
+//! `dressform sim [--form <form.toml>] (--serial-pty | --slcan-pty) [--log <file>]
 //! [--faults <spec>]`: a simulated robotic form on a pseudo-terminal, until Ctrl-C.
 
 use super::Failure;
-use sim::form::FormDescription;
+use super::link::FormArg;
 use sim::serve::{ServeConfig, ServeError, Transport, run_until_ctrl_c};
 use std::io::Write;
 use std::path::PathBuf;
@@ -10,9 +10,8 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 #[command(group = clap::ArgGroup::new("link").required(true))]
 pub struct SimArgs {
-    /// The form description (TOML); `sim/forms/reference.toml` is the reference form.
-    #[arg(long)]
-    form: PathBuf,
+    #[command(flatten)]
+    form: FormArg,
     /// Speak the serial mapping (COBS + CRC) on a pseudo-terminal.
     #[arg(long, group = "link")]
     serial_pty: bool,
@@ -29,7 +28,7 @@ pub struct SimArgs {
 }
 
 pub fn run(args: &SimArgs) -> Result<(), Failure> {
-    let form = FormDescription::load(&args.form).map_err(Failure::bad_input)?;
+    let form = args.form.load()?;
     let faults = args
         .faults
         .as_deref()

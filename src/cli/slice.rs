@@ -19,6 +19,10 @@ pub struct SliceArgs {
     json: bool,
     #[command(flatten)]
     frame: FrameArgs,
+    /// Taubin smoothing passes applied before cutting (default 0: the scan as it is; the
+    /// commands that measure use 8).
+    #[arg(long, default_value_t = 0)]
+    smooth: usize,
 }
 
 #[derive(Serialize)]
@@ -47,7 +51,8 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
     if let Some(h) = args.heights.iter().find(|h| !h.is_finite()) {
         return Err(Failure::bad_input(format!("--heights: {h} is not a height")));
     }
-    let scan = scan::load(&args.mesh, &args.frame.options()).map_err(Failure::bad_input)?;
+    let mut scan = scan::load(&args.mesh, &args.frame.options()).map_err(Failure::bad_input)?;
+    scan.body.taubin_smooth(args.smooth);
     let file = scan.source.display().to_string();
     for w in scan.cleaning.warnings() {
         warn(&file, &w);
@@ -109,7 +114,7 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
     for s in &out.sections {
         outln!("  z = {:.1} mm: {} loops", s.z_mm, s.loops.len());
         for l in &s.loops {
-            let label = l.label.map_or("unlabelled".to_string(), |r| format!("{r:?}"));
+            let label = l.label.map_or("unlabelled", |r| r.name());
             outln!(
                 "    {label:<10} contour {:8.1} mm  tape girth {:8.1} mm  at ({:.0}, {:.0})",
                 l.perimeter_mm,

@@ -1,26 +1,23 @@
 //! `dressform status [--form <form.toml>] (--sim | --serial <path> | --slcan <path> |
 //! --can <iface>) [--json]`: every node's identity, state, faults and positions, without
-//! changing anything.
+//! changing anything. With `--sim`, of a simulated form started for this command (fresh:
+//! Disabled, not homed); `dressform sim` serves one that lasts.
 
-use std::path::PathBuf;
 use std::time::Duration;
 
-use dressform::controller::transport::sim::SimBus;
-use dressform::controller::{Connection, LinkSpec, NodeReport, status};
-use sim::bus::can::{CanBus, CanKind};
-use sim::robot::{SimOptions, SimulatedForm};
+use dressform::controller::simulated::SimConfig;
+use dressform::controller::{LinkSpec, NodeReport, status};
 
 use super::Failure;
-use super::drive::{LinkArgs, load_form, runtime};
+use super::link::{self, FormArg, LinkArgs, runtime};
 
 /// How long to listen for heartbeats and feedback.
 const LISTEN: Duration = Duration::from_millis(300);
 
 #[derive(Debug, clap::Args)]
 pub struct StatusArgs {
-    /// The form description (TOML) [default: the built-in reference form].
-    #[arg(long)]
-    form: Option<PathBuf>,
+    #[command(flatten)]
+    form: FormArg,
     #[command(flatten)]
     link: LinkArgs,
     /// Print JSON on standard output.
@@ -29,22 +26,27 @@ pub struct StatusArgs {
 }
 
 pub fn run(args: &StatusArgs) -> Result<(), Failure> {
-    let form = load_form(args.form.as_ref())?;
+    let form = args.form.load()?;
+    let spec = args.link.spec();
     let reports = runtime()?.block_on(async {
-        match args.link.spec() {
+        match &spec {
             LinkSpec::Sim => {
-                let bus = CanBus::new(CanKind::CLASSIC_1M);
-                let _form =
-                    SimulatedForm::on_can(&form, &bus, &Default::default(), &SimOptions::default())
-                        .map_err(Failure::bad_input)?;
-                status(SimBus::attach(&bus), &form, LISTEN).await.map_err(Failure::other)
+                let rig = link::simulated(&form, &SimConfig::default())?;
+                let transport = rig.attach();
+                let _armed = link::arm(&transport);
+                status(transport, &form, LISTEN).await.map_err(Failure::other)
             }
             spec => {
-                let connection = Connection::open(&spec).map_err(Failure::other)?;
-                status(connection, &form, LISTEN).await.map_err(Failure::other)
+                let owned = link::own(spec)?;
+                status(owned.connection, &form, LISTEN).await.map_err(Failure::other)
             }
         }
     })?;
+    if spec == LinkSpec::Sim && !args.json {
+        outln!(
+            "a simulated form started for this command (fresh; `dressform sim` serves one that lasts):"
+        );
+    }
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&reports).map_err(Failure::other)?);
     } else {
@@ -60,10 +62,9 @@ fn print(reports: &[NodeReport]) {
             (Some(p), Some(f)) => format!("protocol {p}, firmware {f}"),
             _ => "not identified".into(),
         };
-        let faults = if r.faults.is_empty() {
-            String::new()
-        } else {
-            format!(", faults {}", r.faults.join("|"))
+        let faults = match &r.fault_words {
+            Some(words) => format!(", faults {} ({words})", r.faults.join("|")),
+            None => String::new(),
         };
         outln!("node {}: {state} ({version}){faults}", r.node);
         for problem in &r.problems {

@@ -9,35 +9,45 @@
 //! | module | what it holds |
 //! |---|---|
 //! | [`transport`] | the [`Transport`] trait; serial, slcan, SocketCAN and simulated links |
-//! | [`session`] | discovery, enable/home, heartbeats and polls, liveness, reboots |
+//! | [`estop`] | the [`Gate`] every packet goes through, and the e-stop on it from any thread |
+//! | [`control`] | the local control endpoint: `dressform estop` reaching the link's owner |
+//! | [`session`] | discovery, fault reset, enable/home, heartbeats and polls, liveness, faults, reboots |
 //! | [`motion`] | staging, the common SYNC duration, watching feedback, the report |
+//! | [`faults`] | states, faults, events and refusals in words; which faults the host clears |
 //! | [`safety`] | [`SafeTarget`]: the only way a target reaches the wire |
 //! | [`simulated`] | the whole thing on the in-process simulated form |
 //!
 //! Safety rules, all enforced here: targets come only from [`SafeTarget`]s built against the
 //! description's strokes (checked against what every node reports); the SYNC duration is
-//! never shorter than the shortest feasible for every actuator; a fault broadcasts `Halt`;
-//! a lost node, a reboot that cannot be resumed or a failed link end the move with an error;
-//! a stop request (Ctrl-C) broadcasts `EmergencyStop`.
+//! never shorter than the shortest feasible for every actuator; a fault (during homing or a
+//! move) broadcasts `Halt`; a lost node, a reboot that cannot be resumed or a failed link end
+//! the move with an error; an e-stop (another terminal, a signal) latches the link's [`Gate`]
+//! and broadcasts `EmergencyStop` without waiting for the session; a hardware fault is never
+//! cleared without the caller's say-so.
 
+pub mod control;
+pub mod estop;
+pub mod faults;
 pub mod motion;
 pub mod safety;
 pub mod session;
 pub mod simulated;
 pub mod transport;
 
+use std::collections::BTreeMap;
 use std::time::Duration;
 
-use firmware_protocol::drive::{DriveState, Faults};
-use firmware_protocol::{Message, NodeId, Packet};
+use firmware_protocol::NodeId;
+use firmware_protocol::drive::Faults;
 use serde::Serialize;
 use sim::form::FormDescription;
-use tokio::sync::watch;
 use tokio::time::Instant;
 
+pub use estop::{Gate, StopCause};
+pub use faults::{fault_names, state_name};
 pub use motion::{ActuatorReport, MoveError, NodeProgress, PlannedTarget, Progress};
 pub use safety::SafeTarget;
-pub use session::{NodeProblem, Session, SessionError};
+pub use session::{Cleared, NodeProblem, Session, SessionError};
 pub use transport::{Connection, LinkSpec, Transport, TransportError};
 
 use crate::setpoints::{OutOfStroke, SetPoints};
@@ -64,8 +74,9 @@ pub struct DriveOptions {
     pub settle: Duration,
     /// How long homing may take (default 30 s).
     pub homing_timeout: Duration,
-    /// Turn this to `true` to stop: an emergency stop is broadcast (Ctrl-C).
-    pub stop: Option<watch::Receiver<bool>>,
+    /// Clear latched hardware faults (a jam, an overcurrent, a broken encoder...) at start;
+    /// without it only an emergency stop and a host timeout are cleared (default false).
+    pub reset_faults: bool,
 }
 
 impl Default for DriveOptions {
@@ -77,7 +88,7 @@ impl Default for DriveOptions {
             min_duration: Duration::ZERO,
             settle: Duration::from_secs(2),
             homing_timeout: Duration::from_secs(30),
-            stop: None,
+            reset_faults: false,
         }
     }
 }
@@ -95,9 +106,13 @@ pub struct DriveReport {
     pub elapsed_ms: u64,
     /// Every actuator of the set-points, in id order.
     pub actuators: Vec<ActuatorReport>,
+    /// Every actuator of the form whose position was known at the end, mm (those the
+    /// set-points leave out included): what the form's shape is computed from.
+    pub positions_mm: BTreeMap<String, f64>,
     /// Set-points clamped into the stroke: `(id, asked mm, used mm)`.
     pub clamped: Clamped,
-    /// Warnings from the nodes (`DurationTooShort`, ...) and resumed reboots.
+    /// Faults cleared at the start, warnings from the nodes (a move too short, ...) and
+    /// resumed reboots.
     pub warnings: Vec<String>,
 }
 
@@ -152,9 +167,10 @@ pub fn plan(
 }
 
 /// Drives the form to `setpoints`: checks them (refusing or clamping out-of-stroke
-/// positions before anything is sent), discovers and checks every node, enables and homes,
-/// moves every actuator together, watches until all are within tolerance, then disables.
-/// `progress` is called about every 50 ms during the move.
+/// positions before anything is sent), discovers and checks every node, clears latched
+/// faults as [`DriveOptions::reset_faults`] allows, enables and homes, moves every actuator
+/// together, watches until all are within tolerance, then disables. `progress` is called
+/// about every 50 ms during the move.
 pub async fn drive<T: Transport>(
     transport: T,
     form: &FormDescription,
@@ -164,8 +180,19 @@ pub async fn drive<T: Transport>(
 ) -> Result<DriveReport, DriveError> {
     let (plan, clamped) = plan(form, setpoints, options.clamp)?;
     let device = transport.device();
-    let mut session = Session::new(transport, form, options.stop.clone());
+    let mut session = Session::new(transport, form);
     session.discover().await?;
+    let allowed = if options.reset_faults { ANY_FAULT } else { faults::CLEARED_AT_START };
+    let cleared = session.reset_faults(allowed).await?;
+    let remaining: Vec<String> = cleared
+        .iter()
+        .filter(|c| !c.remaining.is_empty())
+        .map(|c| format!("{}: {}", c.node, faults::describe(c.remaining)))
+        .collect();
+    if !remaining.is_empty() {
+        return Err(SessionError::NotCleared(remaining).into());
+    }
+    let mut notes = cleared_notes(&cleared);
     session.enable_all(options.homing_timeout).await?;
     let move_options = motion::MoveOptions {
         tolerance_mm: options.tolerance_mm,
@@ -179,10 +206,13 @@ pub async fn drive<T: Transport>(
             .await;
     let (duration_ms, actuators, warnings) = match result {
         Ok(done) => done,
+        // A session error is the session's, wherever it happened.
         Err(MoveError::Session(e)) => return Err(e.into()),
         Err(e) => return Err(e.into()),
     };
+    notes.extend(warnings);
     let elapsed_ms = started.elapsed().as_millis() as u64;
+    let positions_mm = positions_of(&session);
     session.disable_all().await?;
     let report = DriveReport {
         form: form.name.clone(),
@@ -190,10 +220,39 @@ pub async fn drive<T: Transport>(
         duration_ms,
         elapsed_ms,
         actuators,
+        positions_mm,
         clamped,
-        warnings,
+        warnings: notes,
     };
     if report.converged() { Ok(report) } else { Err(DriveError::NotReached(Box::new(report))) }
+}
+
+/// One note per kind of fault cleared: `cleared the latched emergency stop on nodes 1, 2, 3`.
+fn cleared_notes(cleared: &[Cleared]) -> Vec<String> {
+    let mut by_kind: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    for c in cleared {
+        by_kind.entry(faults::describe(c.faults)).or_default().push(c.node.address.to_string());
+    }
+    by_kind
+        .into_iter()
+        .map(|(what, nodes)| format!("cleared the latched {what} on node(s) {}", nodes.join(", ")))
+        .collect()
+}
+
+/// Every fault flag, the reserved bits included: what `reset_faults` may clear.
+const ANY_FAULT: Faults = Faults::from_bits_retain(u16::MAX);
+
+/// Every actuator of the form whose position the session knows, mm.
+fn positions_of<T: Transport>(session: &Session<T>) -> BTreeMap<String, f64> {
+    session
+        .form()
+        .actuators
+        .iter()
+        .filter_map(|a| {
+            let p = session.nodes().get(&a.node_id()?)?.positions[a.actuator()?.index()]?;
+            Some((a.id.clone(), f64::from(p.hundredths_mm()) / 100.0))
+        })
+        .collect()
 }
 
 /// One node as `dressform status` shows it.
@@ -209,8 +268,10 @@ pub struct NodeReport {
     pub firmware: Option<String>,
     /// Its drive state.
     pub state: Option<String>,
-    /// Its latched faults.
+    /// Its latched faults (`EMERGENCY_STOP`, ...).
     pub faults: Vec<String>,
+    /// Its latched faults in words, if any.
+    pub fault_words: Option<String>,
     /// Actuator id → position, mm (`None`: not homed or not reported).
     pub positions_mm: Vec<(String, Option<f64>)>,
     /// Problems against the description.
@@ -224,7 +285,7 @@ pub async fn status<T: Transport>(
     form: &FormDescription,
     listen: Duration,
 ) -> Result<Vec<NodeReport>, SessionError> {
-    let mut session = Session::new(transport, form, None);
+    let mut session = Session::new(transport, form);
     let mut problems: Vec<(NodeId, Vec<NodeProblem>)> = Vec::new();
     let nodes: Vec<NodeId> = form.node_ids().collect();
     for &node in &nodes {
@@ -247,6 +308,9 @@ pub async fn status<T: Transport>(
                     format!("{}.{}.{}", i.firmware.major, i.firmware.minor, i.firmware.patch)
                 }),
                 state: heartbeat.map(|h| state_name(h.state).to_string()),
+                fault_words: heartbeat
+                    .map(|h| faults::describe(h.faults))
+                    .filter(|_| heartbeat.is_some_and(|h| !h.faults.is_empty())),
                 faults: heartbeat.map(|h| fault_names(h.faults)).unwrap_or_default(),
                 positions_mm: form
                     .actuators_of(node)
@@ -263,26 +327,33 @@ pub async fn status<T: Transport>(
     Ok(reports)
 }
 
-/// The name of a drive state.
-pub fn state_name(state: DriveState) -> &'static str {
-    match state {
-        DriveState::Disabled => "Disabled",
-        DriveState::Enabled => "Enabled",
-        DriveState::Homing => "Homing",
-        DriveState::Fault => "Fault",
-    }
+/// What `dressform reset` found and did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ResetReport {
+    /// Nodes that differ from the description (reset anyway, as far as they answer).
+    pub problems: Vec<NodeProblem>,
+    /// Every node that was in Fault: what it held, what remains.
+    pub cleared: Vec<Cleared>,
 }
 
-/// The names of latched fault flags.
-pub fn fault_names(faults: Faults) -> Vec<String> {
-    faults.iter_names().map(|(name, _)| name.to_string()).collect()
+/// Clears every latched fault whose cause is gone: identifies the nodes (differences from
+/// the description are reported, not fatal), then sends FaultReset to every node in Fault.
+pub async fn reset<T: Transport>(
+    transport: T,
+    form: &FormDescription,
+) -> Result<ResetReport, SessionError> {
+    let mut session = Session::new(transport, form);
+    let mut problems = Vec::new();
+    let nodes: Vec<NodeId> = form.node_ids().collect();
+    for node in nodes {
+        problems.extend(session.identify(node).await?);
+    }
+    let cleared = session.reset_faults(ANY_FAULT).await?;
+    Ok(ResetReport { problems, cleared })
 }
 
-/// Broadcasts an emergency stop (three times, against a lossy bus): every node stops, powers
-/// off and latches `EMERGENCY_STOP` until a FaultReset.
-pub async fn emergency_stop<T: Transport>(mut transport: T) -> Result<(), TransportError> {
-    for _ in 0..3 {
-        transport.send(Packet::broadcast(Message::EmergencyStop)).await?;
-    }
-    Ok(())
+/// Broadcasts an emergency stop on a link this process opened (see [`estop::Gate`]): every
+/// node stops, powers off and latches `EMERGENCY_STOP` until a FaultReset.
+pub fn emergency_stop<T: Transport>(transport: &T) -> Result<(), TransportError> {
+    transport.gate().emergency_stop(StopCause::Requested)
 }

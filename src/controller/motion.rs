@@ -10,7 +10,8 @@
 //!
 //! Safety: targets are [`SafeTarget`]s, and [`node_targets`] is the one place that turns them
 //! into wire positions. A fault event or a node in Fault broadcasts `Halt` (the faulty node is
-//! already stopping) and ends the move with the actuator and the reason. A node that reboots
+//! already stopping) and ends the move with the actuator and the reason
+//! ([`Session::fault`], the same path as during homing). A node that reboots
 //! is re-identified, enabled, homed and given its targets again with a new SYNC (at most
 //! twice per move), or the move fails clearly.
 
@@ -18,7 +19,6 @@ use std::collections::BTreeMap;
 use std::time::Duration;
 
 use firmware_protocol::actuator::MAX_ACTUATORS;
-use firmware_protocol::drive::{DriveCommand, DriveState, EmergencyCode};
 use firmware_protocol::message::Sync;
 use firmware_protocol::update::{NodeTargets, packets, shortest_duration_ms};
 use firmware_protocol::{Actuator, Message, NodeId, Packet};
@@ -100,23 +100,9 @@ pub struct NodeProgress {
 /// Why a move failed.
 #[derive(Debug, thiserror::Error)]
 pub enum MoveError {
-    /// The session failed (link, lost node, interrupted...).
+    /// The session failed (link, lost node, a fault, an e-stop...).
     #[error(transparent)]
     Session(#[from] SessionError),
-    /// A fault stopped the form.
-    #[error("fault on node {node}{}: {code_name} (0x{code:04X}, detail {detail}); every node halted", actuator.as_ref().map(|a| format!(", actuator {a}")).unwrap_or_default())]
-    Fault {
-        /// The node.
-        node: u8,
-        /// The actuator's id, if the fault names one.
-        actuator: Option<String>,
-        /// The emergency code.
-        code: u16,
-        /// Its name.
-        code_name: String,
-        /// Its detail.
-        detail: i32,
-    },
     /// A node rebooted more often than the move resumes.
     #[error("node {node} rebooted {times} times during the move; every node halted")]
     Rebooted {
@@ -130,14 +116,6 @@ pub enum MoveError {
     TooLong(u64),
 }
 
-/// The name of an emergency code.
-pub fn code_name(code: EmergencyCode) -> String {
-    EmergencyCode::KNOWN
-        .iter()
-        .find(|(c, _)| *c == code)
-        .map_or_else(|| format!("unknown code 0x{:04X}", code.0), |(_, name)| (*name).to_string())
-}
-
 /// The wire targets of every node in `plan`: the one place targets become positions.
 pub fn node_targets(plan: &[PlannedTarget]) -> Vec<NodeTargets> {
     let mut nodes: BTreeMap<NodeId, [Option<firmware_protocol::Position>; MAX_ACTUATORS]> =
@@ -148,14 +126,23 @@ pub fn node_targets(plan: &[PlannedTarget]) -> Vec<NodeTargets> {
     nodes.into_iter().map(|(node, targets)| NodeTargets { node, targets }).collect()
 }
 
-/// The shortest common duration for `plan` from the last reported positions, ms.
+/// How far an actuator may be from its last reported position, 0.01 mm: feedback is rounded
+/// and noisy (the simulated nodes' noise is clipped at 0.04 mm) while the node plans from
+/// where it really is; a move planned this much longer never comes out too short for it.
+const FEEDBACK_UNCERTAINTY: u16 = 10;
+
+/// The shortest common duration for `plan` from the last reported positions (each distance
+/// lengthened by the feedback's uncertainty), ms.
 pub fn shortest_common_duration<T: Transport>(session: &Session<T>, plan: &[PlannedTarget]) -> u64 {
     plan.iter()
         .map(|t| {
             let current =
                 session.nodes().get(&t.node).and_then(|s| s.positions[t.actuator.index()]);
             let distance = match current {
-                Some(p) => p.hundredths_mm().abs_diff(t.target.position().hundredths_mm()),
+                Some(p) => {
+                    p.hundredths_mm().abs_diff(t.target.position().hundredths_mm())
+                        + FEEDBACK_UNCERTAINTY
+                }
                 None => t.stroke,
             };
             // Limits of 0 cannot come from a valid description; take the longest then.
@@ -205,9 +192,9 @@ pub async fn run<T: Transport>(
         }
         progress(&progress_of(session, plan, tol, started.elapsed(), planned));
         // Faults first: they stop everything.
-        if let Some(error) = fault(session, plan, &mut warnings) {
-            session.send(Packet::broadcast(Message::Control(DriveCommand::Halt))).await?;
-            return Err(error);
+        if let Some(fault) = session.fault(&mut warnings).await? {
+            session.halt_all().await?;
+            return Err(SessionError::Fault(fault).into());
         }
         let rebooted: Vec<NodeId> =
             session.nodes().iter().filter(|(_, s)| s.rebooted).map(|(&n, _)| n).collect();
@@ -216,7 +203,7 @@ pub async fn run<T: Transport>(
                 let times = reboots.entry(node).or_default();
                 *times += 1;
                 if *times > MAX_RESUMES {
-                    session.send(Packet::broadcast(Message::Control(DriveCommand::Halt))).await?;
+                    session.halt_all().await?;
                     return Err(MoveError::Rebooted { node: node.get(), times: *times });
                 }
                 warnings.push(format!("node {} rebooted during the move; resumed", node.get()));
@@ -385,59 +372,4 @@ fn progress_of<T: Transport>(
         };
     }
     Progress { nodes: nodes.into_values().collect(), elapsed, duration }
-}
-
-/// The first fault among the nodes' events (warnings are kept in `warnings`), or a node in
-/// Fault.
-fn fault<T: Transport>(
-    session: &mut Session<T>,
-    plan: &[PlannedTarget],
-    warnings: &mut Vec<String>,
-) -> Option<MoveError> {
-    let nodes: Vec<NodeId> = session.nodes().keys().copied().collect();
-    let mut found = None;
-    for node in nodes {
-        let events =
-            session.node_mut(node).map(|s| std::mem::take(&mut s.events)).unwrap_or_default();
-        let state = session.nodes().get(&node).and_then(|s| s.heartbeat);
-        for e in events {
-            let actuator = e
-                .actuator
-                .and_then(|a| session.form().actuator_at(node, a).map(|spec| spec.id.clone()));
-            let is_fault = !e.code.fault().is_empty()
-                || (e.code != EmergencyCode::NO_ERROR
-                    && state.is_some_and(|h| h.state == DriveState::Fault));
-            if is_fault && found.is_none() {
-                found = Some(MoveError::Fault {
-                    node: node.get(),
-                    actuator,
-                    code: e.code.0,
-                    code_name: code_name(e.code),
-                    detail: e.detail,
-                });
-            } else if !is_fault && e.code != EmergencyCode::NO_ERROR {
-                let target = actuator.as_deref().unwrap_or("the node");
-                warnings.push(format!(
-                    "node {}, {target}: {} (detail {})",
-                    node.get(),
-                    code_name(e.code),
-                    e.detail
-                ));
-            }
-        }
-        if found.is_none()
-            && let Some(h) = state
-            && h.state == DriveState::Fault
-            && plan.iter().any(|t| t.node == node)
-        {
-            found = Some(MoveError::Fault {
-                node: node.get(),
-                actuator: None,
-                code: 0,
-                code_name: format!("node in Fault, flags {:?}", h.faults),
-                detail: 0,
-            });
-        }
-    }
-    found
 }

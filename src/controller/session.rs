@@ -8,21 +8,34 @@
 //! * host heartbeats: on CAN a broadcast `HostHeartbeat` every 100 ms; on serial, where nodes
 //!   speak only when polled, an addressed `HostHeartbeat` to every node in turn every 20 ms
 //!   (the poll is the heartbeat);
+//!   and, on every link, a broadcast `HostHeartbeat` whenever one is due while the session
+//!   waits for an answer (so a long series of requests never starves a node's watchdog);
 //! * requests (`IdentifyRequest`, `Control`, `Home`) are addressed and sent up to
 //!   [`ATTEMPTS`] times on no answer; an `Ack` other than Ok is an error naming the node;
-//! * a node not heard for [`timing::NODE_LOST_AFTER_MS`] (three heartbeat periods) is lost;
+//! * a node not heard for [`NODE_LOST_AFTER`] (three heartbeat periods) of *listening time*
+//!   is lost: silence counts only while the host's receive loop actually runs
+//!   ([`ListeningClock`]), so a host descheduled by a busy machine does not blame healthy
+//!   nodes for its own stall, and received packets are always taken before silence is judged;
 //! * a node whose heartbeat falls back to Disabled unasked (or forgets its homes) has
 //!   rebooted.
 //!
+//! **Faults** are found one way during homing and during a move ([`Session::fault`]): an
+//! `Emergency` event with a fault code, or a heartbeat in Fault; the session halts every
+//! node and reports the node and actuator in words at once. Latched faults found at the
+//! start are cleared by [`Session::reset_faults`] only within what the caller allows (see
+//! [`super::faults`]).
+//!
 //! Safety: the session never sends targets itself; `motion` builds them from
-//! [`SafeTarget`](super::safety::SafeTarget)s only. Every way out of a failed move goes
-//! through a broadcast `Halt` or `EmergencyStop`.
+//! [`SafeTarget`](super::safety::SafeTarget)s only. Every packet goes through the link's
+//! [`Gate`](super::estop::Gate): once the link is e-stopped, from any thread, nothing else is
+//! sent and the session ends with [`SessionError::Stopped`]. Every way out of a failed move
+//! goes through a broadcast `Halt` or `EmergencyStop`.
 
 use std::collections::BTreeMap;
 use std::time::Duration;
 
 use firmware_protocol::actuator::MAX_ACTUATORS;
-use firmware_protocol::drive::{AckStatus, DriveCommand, DriveState};
+use firmware_protocol::drive::{AckStatus, DriveCommand, DriveState, EmergencyCode, Faults};
 use firmware_protocol::message::{Capabilities, Emergency, Heartbeat, HostHeartbeat, Identity};
 use firmware_protocol::version::Compatibility;
 use firmware_protocol::{
@@ -32,6 +45,8 @@ use sim::form::FormDescription;
 use tokio::sync::watch;
 use tokio::time::{Instant, sleep_until};
 
+use super::estop::StopCause;
+use super::faults::{self, Fault, NodeName};
 use super::transport::{Transport, TransportError};
 
 /// The host heartbeat period on CAN.
@@ -41,6 +56,36 @@ pub const HEARTBEAT_PERIOD: Duration =
 pub const POLL_PERIOD: Duration = Duration::from_millis(timing::FEEDBACK_PERIOD_MS as u64);
 /// A node not heard for this long is lost (three heartbeat periods).
 pub const NODE_LOST_AFTER: Duration = Duration::from_millis(timing::NODE_LOST_AFTER_MS as u64);
+/// The longest a gap between two wakes of the receive loop counts towards a node's silence:
+/// the loop wakes at least every answer timeout (60 ms on serial), so a longer gap is the
+/// host's own stall (one heartbeat period allows for a busy machine).
+pub const LONGEST_COUNTED_GAP: Duration = HEARTBEAT_PERIOD;
+/// How long to wait for the `Emergency` event of a node seen in Fault (on serial it comes
+/// after the heartbeat, in the same poll answer; two poll periods leave room).
+const EVENT_GRACE: Duration = Duration::from_millis(2 * timing::FEEDBACK_PERIOD_MS as u64);
+
+/// Time in which the host was listening: wall time, except that a gap between two wakes of
+/// the receive loop longer than [`LONGEST_COUNTED_GAP`] (the process was descheduled) counts
+/// only that much.
+#[derive(Clone, Copy, Debug)]
+pub struct ListeningClock {
+    listened: Duration,
+    last: Instant,
+}
+
+impl ListeningClock {
+    fn new() -> Self {
+        Self { listened: Duration::ZERO, last: Instant::now() }
+    }
+
+    /// Counts the time since the last tick; returns the listening time now.
+    fn tick(&mut self) -> Duration {
+        let now = Instant::now();
+        self.listened += now.saturating_duration_since(self.last).min(LONGEST_COUNTED_GAP);
+        self.last = now;
+        self.listened
+    }
+}
 
 /// What the host knows about one node.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -55,8 +100,8 @@ pub struct NodeStatus {
     pub heartbeat_at: Option<Instant>,
     /// Its actuators' last reported positions (`None`: unknown).
     pub positions: [Option<Position>; MAX_ACTUATORS],
-    /// When it was last heard from.
-    pub last_heard: Option<Instant>,
+    /// When it was last heard from, in the session's listening time.
+    pub heard: Option<Duration>,
     /// Its `Emergency` events not yet handled, oldest first.
     pub events: Vec<Emergency>,
     /// It fell back to Disabled with its homes forgotten since this was last cleared.
@@ -106,7 +151,7 @@ pub enum SessionError {
     #[error("the form does not match its description:\n  {}", list(.0))]
     Discovery(Vec<NodeProblem>),
     /// A node refused a request.
-    #[error("node {node}: {request} refused: {status:?}{hint}")]
+    #[error("node {node}: {request} refused: {}{hint}", faults::refusal_words(*.status))]
     Refused {
         /// The node.
         node: u8,
@@ -140,12 +185,44 @@ pub enum SessionError {
     Homing {
         /// How long the host waited.
         timeout: Duration,
-        /// The nodes still homing, with their state.
+        /// The nodes still homing, with their state in words.
         nodes: Vec<String>,
     },
-    /// The user stopped the session (Ctrl-C): an emergency stop was sent.
-    #[error("interrupted: emergency stop sent to every node")]
-    Interrupted,
+    /// A fault stopped the form (every node was halted).
+    #[error("fault on {0}; every node halted")]
+    Fault(Fault),
+    /// Nodes hold latched faults the caller does not allow the host to clear.
+    #[error("latched faults the host does not clear on its own:\n  {}", .0.join("\n  "))]
+    Latched(Vec<String>),
+    /// A FaultReset did not clear a node's faults (their cause remains).
+    #[error("faults not cleared (their cause remains):\n  {}", .0.join("\n  "))]
+    NotCleared(Vec<String>),
+    /// The link was e-stopped (another terminal, a signal): the session sent nothing more.
+    #[error("stopped by {0}: emergency stop sent to every node")]
+    Stopped(StopCause),
+}
+
+/// A node's latched faults, as found and after a FaultReset.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Cleared {
+    /// The node.
+    pub node: NodeName,
+    /// Its faults before the reset.
+    pub faults: Faults,
+    /// The actuators its fault events named.
+    pub actuators: Vec<String>,
+    /// What the reset left latched (empty: cleared).
+    pub remaining: Faults,
+}
+
+impl std::fmt::Display for Cleared {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.node)?;
+        if !self.actuators.is_empty() {
+            write!(f, ", {}", self.actuators.join(", "))?;
+        }
+        write!(f, ": {}", faults::describe(self.faults))
+    }
 }
 
 fn list(problems: &[NodeProblem]) -> String {
@@ -161,8 +238,10 @@ pub struct Session<T> {
     nodes: BTreeMap<NodeId, NodeStatus>,
     unexpected: Vec<u8>,
     next_service: Instant,
+    next_heartbeat: Instant,
     watch_liveness: bool,
-    stop: Option<watch::Receiver<bool>>,
+    stopped: watch::Receiver<Option<StopCause>>,
+    clock: ListeningClock,
 }
 
 /// How many times a request is sent before its node is reported: the protocol's two
@@ -184,20 +263,30 @@ fn answer_timeout(link: Link) -> Duration {
 }
 
 impl<T: Transport> Session<T> {
-    /// A session with `form`'s nodes over `transport`; nothing is sent yet. A `stop` that
-    /// turns true makes the session send an emergency stop and fail with
-    /// [`SessionError::Interrupted`].
-    pub fn new(transport: T, form: &FormDescription, stop: Option<watch::Receiver<bool>>) -> Self {
+    /// A session with `form`'s nodes over `transport`; nothing is sent yet. Once the link is
+    /// e-stopped (see [`Gate`](super::estop::Gate)) the session fails with
+    /// [`SessionError::Stopped`].
+    pub fn new(transport: T, form: &FormDescription) -> Self {
         let nodes = form.node_ids().map(|n| (n, NodeStatus::default())).collect();
+        let stopped = transport.gate().watch();
         Self {
             transport,
             form: form.clone(),
             nodes,
             unexpected: Vec::new(),
             next_service: Instant::now(),
+            next_heartbeat: Instant::now(),
             watch_liveness: false,
-            stop,
+            stopped,
+            clock: ListeningClock::new(),
         }
+    }
+
+    /// How messages name `node`: its address and label.
+    pub fn node_name(&self, node: NodeId) -> NodeName {
+        let label =
+            self.form.nodes.iter().find(|n| n.address == node.get()).and_then(|n| n.label.clone());
+        NodeName { address: node.get(), label }
     }
 
     /// The form description.
@@ -225,17 +314,17 @@ impl<T: Transport> Session<T> {
         &self.unexpected
     }
 
-    /// Sends one packet.
+    /// Sends one packet (refused once the link is e-stopped).
     pub async fn send(&mut self, packet: Packet) -> Result<(), SessionError> {
-        Ok(self.transport.send(packet).await?)
+        match self.transport.send(packet).await {
+            Err(TransportError::Stopped { cause, .. }) => Err(SessionError::Stopped(cause)),
+            result => Ok(result?),
+        }
     }
 
-    /// Broadcasts an emergency stop (three times, against a lossy bus).
-    pub async fn emergency_stop(&mut self) -> Result<(), SessionError> {
-        for _ in 0..3 {
-            self.send(Packet::broadcast(Message::EmergencyStop)).await?;
-        }
-        Ok(())
+    /// Broadcasts `Halt`: every node stops its moves and homing, and stays Enabled.
+    pub async fn halt_all(&mut self) -> Result<(), SessionError> {
+        self.send(Packet::broadcast(Message::Control(DriveCommand::Halt))).await
     }
 
     fn handle(&mut self, packet: Packet) {
@@ -249,7 +338,7 @@ impl<T: Transport> Session<T> {
             }
             return;
         };
-        status.last_heard = Some(Instant::now());
+        status.heard = Some(self.clock.tick());
         match packet.message {
             Message::Heartbeat(h) => {
                 // Back to Disabled without being told (only Disable does that), or homes
@@ -277,36 +366,42 @@ impl<T: Transport> Session<T> {
         }
     }
 
-    fn stopped(&self) -> bool {
-        self.stop.as_ref().is_some_and(|s| *s.borrow())
+    /// Fails once the link was e-stopped.
+    fn check_stopped(&self) -> Result<(), SessionError> {
+        match *self.stopped.borrow() {
+            Some(cause) => Err(SessionError::Stopped(cause)),
+            None => Ok(()),
+        }
+    }
+
+    /// A broadcast host heartbeat when one is due (on serial, between polls too).
+    async fn keep_alive(&mut self) -> Result<(), SessionError> {
+        let now = Instant::now();
+        if now >= self.next_heartbeat {
+            self.next_heartbeat = now + HEARTBEAT_PERIOD;
+            let heartbeat = Message::HostHeartbeat(HostHeartbeat { protocol: PROTOCOL_VERSION });
+            self.send(Packet::broadcast(heartbeat)).await?;
+        }
+        Ok(())
     }
 
     /// Receives and handles packets until `done` holds for one (returned) or `deadline`.
+    /// Packets already received are taken before the deadline is honoured, so silence is
+    /// never judged on a backlog.
     async fn receive_until(
         &mut self,
         deadline: Instant,
         mut done: impl FnMut(&Packet) -> bool,
     ) -> Result<Option<Packet>, SessionError> {
+        let mut stopped = self.stopped.clone();
         loop {
-            if self.stopped() {
-                self.emergency_stop().await?;
-                return Err(SessionError::Interrupted);
-            }
-            if Instant::now() >= deadline {
-                return Ok(None);
-            }
-            let mut stop = self.stop.clone();
-            let stop_changed = async {
-                match stop.as_mut() {
-                    Some(s) => {
-                        if s.changed().await.is_err() {
-                            std::future::pending::<()>().await;
-                        }
-                    }
-                    None => std::future::pending().await,
-                }
-            };
+            self.check_stopped()?;
+            self.keep_alive().await?;
+            let wake = deadline.min(self.next_heartbeat);
             tokio::select! {
+                biased;
+                // A closed watch cannot change again: nothing to wait for there.
+                Ok(()) = stopped.changed() => {}
                 packet = self.transport.recv() => {
                     let packet = packet?;
                     self.handle(packet);
@@ -314,8 +409,12 @@ impl<T: Transport> Session<T> {
                         return Ok(Some(packet));
                     }
                 }
-                () = sleep_until(deadline) => return Ok(None),
-                () = stop_changed => {}
+                () = sleep_until(wake) => {
+                    self.clock.tick();
+                    if Instant::now() >= deadline {
+                        return Ok(None);
+                    }
+                }
             }
         }
     }
@@ -354,9 +453,9 @@ impl<T: Transport> Session<T> {
         if now < self.next_service {
             return Ok(());
         }
-        let heartbeat = Message::HostHeartbeat(HostHeartbeat { protocol: PROTOCOL_VERSION });
         if self.link() == Link::Serial {
             self.next_service = now + POLL_PERIOD;
+            let heartbeat = Message::HostHeartbeat(HostHeartbeat { protocol: PROTOCOL_VERSION });
             let nodes: Vec<NodeId> = self.nodes.keys().copied().collect();
             for node in nodes {
                 // A lost poll is noticed by liveness, not retried.
@@ -369,16 +468,17 @@ impl<T: Transport> Session<T> {
             }
         } else {
             self.next_service = now + HEARTBEAT_PERIOD;
-            self.send(Packet::broadcast(heartbeat)).await?;
+            self.next_heartbeat = now;
+            self.keep_alive().await?;
         }
         Ok(())
     }
 
-    /// The first node not heard for [`NODE_LOST_AFTER`].
-    fn lost(&self) -> Option<(NodeId, Duration)> {
-        let now = Instant::now();
+    /// The first node not heard for [`NODE_LOST_AFTER`] of listening time.
+    fn lost(&mut self) -> Option<(NodeId, Duration)> {
+        let now = self.clock.tick();
         self.nodes.iter().find_map(|(&node, status)| {
-            let silent = now.saturating_duration_since(status.last_heard?);
+            let silent = now.saturating_sub(status.heard?);
             (silent > NODE_LOST_AFTER).then_some((node, silent))
         })
     }
@@ -437,8 +537,9 @@ impl<T: Transport> Session<T> {
             .await?;
         }
         let status = self.nodes.get(&node).cloned().unwrap_or_default();
+        let now = self.clock.tick();
         if let Some(status) = self.nodes.get_mut(&node) {
-            status.last_heard = Some(Instant::now());
+            status.heard = Some(now);
         }
         Ok(self.check(node, &status))
     }
@@ -542,10 +643,12 @@ impl<T: Transport> Session<T> {
             Message::Ack(ack) if ack.status == AckStatus::Ok => Ok(()),
             Message::Ack(ack) => {
                 let hint = match self.nodes.get(&node).and_then(|s| s.heartbeat) {
-                    Some(h) if !h.faults.is_empty() => {
-                        format!(" (node in {:?}, faults {:?})", h.state, h.faults)
-                    }
-                    Some(h) => format!(" (node in {:?})", h.state),
+                    Some(h) if !h.faults.is_empty() => format!(
+                        " (node {}: {})",
+                        faults::state_name(h.state),
+                        faults::describe(h.faults)
+                    ),
+                    Some(h) => format!(" (node {})", faults::state_name(h.state)),
                     None => String::new(),
                 };
                 Err(SessionError::Refused {
@@ -564,17 +667,9 @@ impl<T: Transport> Session<T> {
         self.form.actuators_of(node).iter().filter_map(|a| a.actuator()).collect()
     }
 
-    /// Enables `node` (after a FaultReset if it is in Fault) and homes its actuators whose
-    /// home is unknown. Does not wait for homing to finish.
+    /// Enables `node` and homes its actuators whose home is unknown (latched faults are
+    /// [`Session::reset_faults`]'s). Does not wait for homing to finish.
     pub async fn enable(&mut self, node: NodeId) -> Result<(), SessionError> {
-        if self
-            .nodes
-            .get(&node)
-            .and_then(|s| s.heartbeat)
-            .is_some_and(|h| h.state == DriveState::Fault)
-        {
-            self.control(node, DriveCommand::FaultReset).await?;
-        }
         // A recent host heartbeat first: nodes refuse Enable without one (InvalidState), so
         // after a lost heartbeat, another heartbeat and another try.
         let mut attempts = 1;
@@ -623,6 +718,148 @@ impl<T: Transport> Session<T> {
         })
     }
 
+    /// Waits (up to [`NODE_LOST_AFTER`]) for a heartbeat from every node sent after now: on
+    /// serial, nodes speak only when polled, so what is known may be from before.
+    pub async fn refresh(&mut self) -> Result<(), SessionError> {
+        let since = Instant::now();
+        self.next_service = since;
+        let fresh = |s: &Self| s.nodes.values().all(|n| n.heartbeat_at.is_some_and(|t| t > since));
+        self.wait_until(since + NODE_LOST_AFTER, fresh).await?;
+        Ok(())
+    }
+
+    /// Clears the latched faults of every node within `allowed`: refuses (sending nothing)
+    /// when a node holds another fault ([`SessionError::Latched`], naming the node, the
+    /// actuators its events named, and the faults in words); otherwise sends FaultReset to
+    /// every node in Fault, after a fresh host heartbeat (the node checks the host is alive
+    /// before clearing a host timeout). Returns, per node that was in Fault, what it held and
+    /// what remains. Events from before are consumed.
+    pub async fn reset_faults(&mut self, allowed: Faults) -> Result<Vec<Cleared>, SessionError> {
+        self.refresh().await?;
+        // Events still pending on a node (serial keeps them for the next poll) are old news
+        // by now: take them for the actuators they name.
+        self.wait_until(Instant::now() + EVENT_GRACE, |_| false).await?;
+        let mut found = Vec::new();
+        for (&node, status) in &mut self.nodes {
+            let events = std::mem::take(&mut status.events);
+            let Some(h) = status.heartbeat.filter(|h| h.state == DriveState::Fault) else {
+                continue;
+            };
+            let mut actuators: Vec<String> = events
+                .iter()
+                .filter(|e| !e.code.fault().is_empty())
+                .filter_map(|e| self.form.actuator_at(node, e.actuator?).map(|a| a.id.clone()))
+                .collect();
+            actuators.dedup();
+            found.push((node, h.faults, actuators));
+        }
+        let mut cleared: Vec<Cleared> = found
+            .into_iter()
+            .map(|(node, faults, actuators)| Cleared {
+                node: self.node_name(node),
+                faults,
+                actuators,
+                remaining: faults,
+            })
+            .collect();
+        let refused: Vec<String> = cleared
+            .iter()
+            .filter(|c| !allowed.contains(c.faults))
+            .map(ToString::to_string)
+            .collect();
+        if !refused.is_empty() {
+            return Err(SessionError::Latched(refused));
+        }
+        for c in &mut cleared {
+            let Some(node) = NodeId::new(c.node.address) else { continue };
+            self.next_heartbeat = Instant::now();
+            self.keep_alive().await?;
+            match self.control(node, DriveCommand::FaultReset).await {
+                Ok(()) => c.remaining = Faults::empty(),
+                Err(SessionError::Refused { .. }) => {}
+                Err(e) => return Err(e),
+            }
+        }
+        // The heartbeats after the resets show what remains.
+        self.refresh().await?;
+        for c in &mut cleared {
+            let heartbeat = NodeId::new(c.node.address)
+                .and_then(|n| self.nodes.get(&n))
+                .and_then(|s| s.heartbeat);
+            if let Some(h) = heartbeat {
+                c.remaining = if h.state == DriveState::Fault { h.faults } else { Faults::empty() };
+            }
+        }
+        for status in self.nodes.values_mut() {
+            status.events.clear();
+        }
+        Ok(cleared)
+    }
+
+    /// The first fault among the nodes: an `Emergency` event with a fault code, or a node
+    /// in Fault (for which its event is awaited a little, to name the actuator). Warnings
+    /// found on the way go to `warnings`. Events are consumed.
+    pub async fn fault(
+        &mut self,
+        warnings: &mut Vec<String>,
+    ) -> Result<Option<Fault>, SessionError> {
+        if let Some(fault) = self.take_fault_event(warnings) {
+            return Ok(Some(fault));
+        }
+        let in_fault = |s: &Self| {
+            s.nodes
+                .iter()
+                .find(|(_, st)| st.heartbeat.is_some_and(|h| h.state == DriveState::Fault))
+                .map(|(&n, _)| n)
+        };
+        let Some(node) = in_fault(self) else { return Ok(None) };
+        let has_event = |s: &Self| {
+            s.nodes.values().any(|st| st.events.iter().any(|e| !e.code.fault().is_empty()))
+        };
+        self.wait_until(Instant::now() + EVENT_GRACE, has_event).await?;
+        if let Some(fault) = self.take_fault_event(warnings) {
+            return Ok(Some(fault));
+        }
+        let flags =
+            self.nodes.get(&node).and_then(|s| s.heartbeat).map_or(Faults::empty(), |h| h.faults);
+        Ok(Some(Fault {
+            node: self.node_name(node),
+            actuator: None,
+            what: faults::describe(flags),
+        }))
+    }
+
+    /// Consumes every node's events: the first fault is returned, warnings are kept.
+    fn take_fault_event(&mut self, warnings: &mut Vec<String>) -> Option<Fault> {
+        let mut found = None;
+        let nodes: Vec<NodeId> = self.nodes.keys().copied().collect();
+        for node in nodes {
+            let Some(status) = self.nodes.get_mut(&node) else { continue };
+            let events = std::mem::take(&mut status.events);
+            let in_fault = status.heartbeat.is_some_and(|h| h.state == DriveState::Fault);
+            for e in events {
+                let actuator = e
+                    .actuator
+                    .and_then(|a| self.form.actuator_at(node, a).map(|spec| spec.id.clone()));
+                // An unknown code is a fault if the node is in Fault (the README's rule).
+                let is_fault = !e.code.fault().is_empty()
+                    || (e.code != EmergencyCode::NO_ERROR
+                        && in_fault
+                        && EmergencyCode::KNOWN.iter().all(|(c, _)| *c != e.code));
+                let what = faults::event_words(e.code, e.detail);
+                if is_fault {
+                    if found.is_none() {
+                        found = Some(Fault { node: self.node_name(node), actuator, what });
+                    }
+                } else if e.code != EmergencyCode::NO_ERROR {
+                    let target = actuator.unwrap_or_else(|| "the node".into());
+                    warnings.push(format!("{}, {target}: {what}", self.node_name(node)));
+                }
+            }
+        }
+        found
+    }
+
     /// Enables every node, homes what needs it, and waits until all are ready.
     pub async fn enable_all(&mut self, homing_timeout: Duration) -> Result<(), SessionError> {
         let nodes: Vec<NodeId> = self.nodes.keys().copied().collect();
@@ -639,15 +876,28 @@ impl<T: Transport> Session<T> {
         timeout: Duration,
     ) -> Result<(), SessionError> {
         let deadline = Instant::now() + timeout;
+        let mut warnings = Vec::new();
         // A node that reboots meanwhile is identified and enabled again (a few times).
         for _ in 0..=REENABLES {
             let rebooted =
                 |s: &Self| nodes.iter().any(|n| s.nodes.get(n).is_some_and(|s| s.rebooted));
-            if self
-                .wait_until(deadline, |s| nodes.iter().all(|&n| s.ready(n)) || rebooted(s))
-                .await?
-                && !rebooted(self)
-            {
+            let faulted = |s: &Self| {
+                s.nodes.values().any(|st| {
+                    st.heartbeat.is_some_and(|h| h.state == DriveState::Fault)
+                        || st.events.iter().any(|e| !e.code.fault().is_empty())
+                })
+            };
+            let finished = self
+                .wait_until(deadline, |s| {
+                    nodes.iter().all(|&n| s.ready(n)) || rebooted(s) || faulted(s)
+                })
+                .await?;
+            // A fault during homing: reported at once, as during a move.
+            if let Some(fault) = self.fault(&mut warnings).await? {
+                self.halt_all().await?;
+                return Err(SessionError::Fault(fault));
+            }
+            if finished && !rebooted(self) {
                 return Ok(());
             }
             let again: Vec<NodeId> = nodes
@@ -673,8 +923,11 @@ impl<T: Transport> Session<T> {
             .iter()
             .filter(|&&n| !self.ready(n))
             .map(|&n| {
-                let state = self.nodes.get(&n).and_then(|s| s.heartbeat);
-                format!("node {} ({:?})", n.get(), state.map(|h| (h.state, h.faults)))
+                let state = match self.nodes.get(&n).and_then(|s| s.heartbeat) {
+                    Some(h) => faults::state_name(h.state),
+                    None => "no heartbeat",
+                };
+                format!("{} ({state})", self.node_name(n))
             })
             .collect();
         Err(SessionError::Homing { timeout, nodes: pending })

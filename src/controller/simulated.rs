@@ -2,8 +2,9 @@
 //! try a set-point file without hardware, or chain mannequin → set-points → drive in tests
 //! and demos.
 //!
-//! [`drive_on_sim`] runs inside a tokio runtime (deterministic under a paused clock);
-//! [`drive_simulated`] starts a real-time runtime of its own.
+//! A [`SimulatedRig`] is the form and its bus, living as long as the caller keeps it (one
+//! command of the CLI); [`drive_on_sim`] drives a fresh one inside a tokio runtime
+//! (deterministic under a paused clock).
 
 use std::path::PathBuf;
 
@@ -47,16 +48,73 @@ pub enum SimDriveError {
     /// The simulated form could not start (invalid form or fault spec).
     #[error(transparent)]
     Sim(#[from] SimError),
-    /// The log could not be written, or no runtime started.
-    #[error("{0}")]
-    Io(String),
+    /// The candump log could not be created or written.
+    #[error("candump log {}: {message}", path.display())]
+    Log {
+        /// The log file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
     /// The drive failed.
     #[error(transparent)]
     Drive(#[from] DriveError),
 }
 
-/// Drives a simulated `form` to `setpoints`; returns the report and the simulated truth at
-/// the end. Must run within a tokio runtime.
+/// A simulated form on its bus (with the bus's log), running until dropped.
+#[derive(Debug)]
+pub struct SimulatedRig {
+    // Declared first: the nodes stop before the bus.
+    form: SimulatedForm,
+    bus: CanBus,
+    log: Option<PathBuf>,
+}
+
+impl SimulatedRig {
+    /// Powers `form` on as `config` says. Must be called within a tokio runtime.
+    pub fn start(form: &FormDescription, config: &SimConfig) -> Result<Self, SimDriveError> {
+        let log =
+            match &config.log {
+                Some(path) => Some(CandumpLog::create(path, "can0").map_err(|e| {
+                    SimDriveError::Log { path: path.clone(), message: e.to_string() }
+                })?),
+                None => None,
+            };
+        let bus = CanBus::with(config.kind, &config.faults, log);
+        let form = SimulatedForm::on_can(form, &bus, &config.faults, &config.options)?;
+        Ok(Self { form, bus, log: config.log.clone() })
+    }
+
+    /// The host's link to the form.
+    pub fn attach(&self) -> SimBus {
+        SimBus::attach(&self.bus)
+    }
+
+    /// The truth about every node and actuator now.
+    pub fn truth(&self) -> FormState {
+        self.form.state()
+    }
+
+    /// The log's first write error so far (a full disk...), naming the file.
+    pub fn log_failure(&self) -> Option<SimDriveError> {
+        let path = self.log.clone()?;
+        self.bus.log_failure().map(|message| SimDriveError::Log { path, message })
+    }
+
+    /// Writes out the log; returns the truth at the end.
+    pub fn finish(self) -> Result<FormState, SimDriveError> {
+        let truth = self.form.state();
+        match (&self.log, self.bus.flush_log()) {
+            (Some(path), Err(e)) => {
+                Err(SimDriveError::Log { path: path.clone(), message: e.to_string() })
+            }
+            _ => Ok(truth),
+        }
+    }
+}
+
+/// Drives a fresh simulated `form` to `setpoints`; returns the report and the simulated
+/// truth at the end. Must run within a tokio runtime.
 pub async fn drive_on_sim(
     form: &FormDescription,
     setpoints: &SetPoints,
@@ -64,32 +122,8 @@ pub async fn drive_on_sim(
     config: &SimConfig,
     progress: impl FnMut(&Progress),
 ) -> Result<(DriveReport, FormState), SimDriveError> {
-    let log = match &config.log {
-        Some(path) => Some(
-            CandumpLog::create(path, "can0")
-                .map_err(|e| SimDriveError::Io(format!("{}: {e}", path.display())))?,
-        ),
-        None => None,
-    };
-    let bus = CanBus::with(config.kind, &config.faults, log);
-    let simulated = SimulatedForm::on_can(form, &bus, &config.faults, &config.options)?;
-    let result = drive(SimBus::attach(&bus), form, setpoints, options, progress).await;
-    let truth = simulated.state();
-    bus.flush_log().map_err(|e| SimDriveError::Io(format!("candump log: {e}")))?;
+    let rig = SimulatedRig::start(form, config)?;
+    let result = drive(rig.attach(), form, setpoints, options, progress).await;
+    let truth = rig.finish()?;
     Ok((result?, truth))
-}
-
-/// [`drive_on_sim`] on a real-time runtime of its own (no runtime needed by the caller).
-pub fn drive_simulated(
-    form: &FormDescription,
-    setpoints: &SetPoints,
-    options: &DriveOptions,
-    config: &SimConfig,
-    progress: impl FnMut(&Progress),
-) -> Result<(DriveReport, FormState), SimDriveError> {
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .map_err(|e| SimDriveError::Io(format!("cannot start the runtime: {e}")))?;
-    runtime.block_on(drive_on_sim(form, setpoints, options, config, progress))
 }

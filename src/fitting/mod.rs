@@ -12,13 +12,16 @@
 //! **Frame.** The mannequin's symmetry plane is put on the form's (x = 0); both use the
 //! canonical frame otherwise (+X = the subject's left, front = -Y).
 
+pub mod outcome;
 mod placement;
 mod rings;
 
+pub use outcome::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
 pub use placement::{Anchor, Placement};
-pub use rings::{RingFit, Saturation, region_of, ring_girth};
+pub use rings::{RingFit, SHAPE_NOTE_MM, Saturation, region_of, ring_girth};
 
 use crate::profiles::Profiles;
+use crate::regions::Region;
 use serde::Serialize;
 use sim::form::FormDescription;
 use std::collections::BTreeMap;
@@ -35,29 +38,49 @@ pub struct Fit {
 }
 
 impl Fit {
-    /// Rings that cannot reach the mannequin's section (an actuator saturates).
+    /// Rings that cannot reach the mannequin's section (an actuator saturates by at least
+    /// [`SHAPE_NOTE_MM`]).
     pub fn saturated(&self) -> impl Iterator<Item = &RingFit> {
         self.rings.iter().filter(|r| !r.saturated.is_empty())
+    }
+
+    /// The mannequin's tape girth at every ring that shapes it (ring → mm): what the form
+    /// should reach ([`outcome`]). Rings where the mannequin has no section are left out.
+    pub fn target_girths(&self) -> BTreeMap<String, f64> {
+        self.rings
+            .iter()
+            .filter(|r| r.mannequin_girth_mm > 0.0)
+            .map(|r| (r.ring.clone(), r.mannequin_girth_mm))
+            .collect()
     }
 }
 
 /// Why a fit could not be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FitError {
-    /// The profiles have no layers.
-    #[error("the profiles have no layers")]
-    NoLayers,
+    /// The profiles cannot give set-points (see [`Profiles::validate`]).
+    #[error("{}", .0.join("; "))]
+    Invalid(Vec<String>),
     /// A ring has no actuators.
     #[error("ring {0} has no actuators")]
     EmptyRing(String),
 }
 
+/// The mannequin regions `form`'s rings shape, each once.
+pub fn regions_of(form: &FormDescription) -> Vec<Region> {
+    let mut regions: Vec<Region> = Vec::new();
+    for region in form.rings.iter().map(region_of) {
+        if !regions.contains(&region) {
+            regions.push(region);
+        }
+    }
+    regions
+}
+
 /// Fits `form` to the mannequin of `profiles`: every actuator gets an extension within its
 /// stroke; mirror pairs get equal extensions.
 pub fn fit(profiles: &Profiles, form: &FormDescription) -> Result<Fit, FitError> {
-    if profiles.layers.is_empty() {
-        return Err(FitError::NoLayers);
-    }
+    profiles.validate(&regions_of(form)).map_err(FitError::Invalid)?;
     let placement = Placement::new(profiles, form);
     let mut positions_mm = BTreeMap::new();
     let mut fits = Vec::with_capacity(form.rings.len());

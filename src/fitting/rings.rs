@@ -19,7 +19,12 @@ use serde::Serialize;
 use sim::form::{ActuatorSpec, FormDescription, RingSpec};
 use std::collections::BTreeMap;
 
-/// An actuator that cannot reach its target.
+/// The smallest shortfall reported as a shape note, mm: below it the gap is within what the
+/// mannequin's own surface is known to (a denoised scan's sections to about a millimetre),
+/// and listing it would bury the real problems.
+pub const SHAPE_NOTE_MM: f64 = 1.0;
+
+/// An actuator that cannot reach its target by at least [`SHAPE_NOTE_MM`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Saturation {
     /// The actuator.
@@ -49,7 +54,7 @@ pub struct RingFit {
     /// The largest distance, along an actuator's direction, between its panel and the
     /// mannequin (mm).
     pub largest_radial_gap_mm: f64,
-    /// Actuators that cannot reach their targets.
+    /// Actuators that cannot reach their targets by [`SHAPE_NOTE_MM`] or more.
     pub saturated: Vec<Saturation>,
 }
 
@@ -188,7 +193,8 @@ pub(super) fn fit_ring(
         .zip(raw(if matched { delta } else { 0.0 }))
         .filter_map(|(a, e)| {
             let beyond = if e > a.stroke_mm { e - a.stroke_mm } else { e.min(0.0) };
-            (beyond.abs() > 0.05).then(|| Saturation { actuator: a.id.clone(), beyond_mm: beyond })
+            (beyond.abs() >= SHAPE_NOTE_MM)
+                .then(|| Saturation { actuator: a.id.clone(), beyond_mm: beyond })
         })
         .collect();
     Ok((report, actuators.iter().map(|a| a.id.clone()).zip(extensions).collect()))

@@ -15,6 +15,7 @@ pub struct TableRow {
     /// "chest", "waist" or "hip".
     pub measure: &'static str,
     /// Height of the level (mm).
+    #[serde(rename = "z_mm")]
     pub z: f64,
     /// The input's girth.
     pub input: Girth,
@@ -32,12 +33,16 @@ pub struct MirrorRow {
     /// "input", "left-mirrored", "right-mirrored" or "mannequin".
     pub body: &'static str,
     /// Width of the hip section (mm).
+    #[serde(rename = "hip_width_mm")]
     pub hip_width: f64,
     /// Chest, waist, hip tape girths (mm).
+    #[serde(rename = "chest_mm")]
     pub chest: f64,
     /// Waist tape girth (mm).
+    #[serde(rename = "waist_mm")]
     pub waist: f64,
     /// Hip tape girth (mm).
+    #[serde(rename = "hip_mm")]
     pub hip: f64,
 }
 

@@ -2,8 +2,9 @@
 //!
 //! Every girth is horizontal and taken on the torso's loop; the tape girth is the convex
 //! hull's perimeter. Levels are found on the input body (canonical frame, mm):
-//! - **chest**: the largest torso tape girth from 10% of the height below the armpits up to
-//!   1% below them (bust/chest: maximum girth just below the armpits);
+//! - **chest**: the largest torso tape girth from 10% of the height below the lower armpit up
+//!   to 1% below it (bust/chest: maximum girth just below the armpits; above the lower armpit
+//!   a raised arm would join the loop);
 //! - **hip**: where the buttocks protrude most (the torso's greatest +Y, i.e. backward, extent)
 //!   between the crotch and 35% of the way up to the armpits; where they protrude within 1 mm of
 //!   that over a range of levels (a flat seat), the middle of that range;
@@ -20,8 +21,10 @@
 //! is the same height on the input.
 
 mod compare;
+mod dimensions;
 
 pub use compare::{Comparison, MirrorRow, TableRow, compare};
+pub use dimensions::{Bilateral, BodyDimensions, KNEE_OF_CROTCH, THIGH_BELOW_CROTCH, dimensions};
 
 use crate::mesh::Mesh;
 use crate::regions::BodyRegions;
@@ -35,10 +38,13 @@ const LEVEL_STEP_MM: f64 = 2.0;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Girth {
     /// Height (mm).
+    #[serde(rename = "z_mm")]
     pub z: f64,
     /// Tape girth: the convex hull's perimeter (mm).
+    #[serde(rename = "tape_mm")]
     pub tape: f64,
     /// The contour's own length (mm).
+    #[serde(rename = "contour_mm")]
     pub contour: f64,
 }
 
@@ -52,10 +58,13 @@ impl Girth {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct Levels {
     /// Chest level (mm).
+    #[serde(rename = "chest_mm")]
     pub chest: f64,
     /// Waist level (mm).
+    #[serde(rename = "waist_mm")]
     pub waist: f64,
     /// Hip level (mm).
+    #[serde(rename = "hip_mm")]
     pub hip: f64,
 }
 
@@ -63,8 +72,10 @@ pub struct Levels {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Measurements {
     /// Height (mm).
+    #[serde(rename = "height_mm")]
     pub height: f64,
     /// Crotch height, the inseam (mm).
+    #[serde(rename = "crotch_height_mm")]
     pub crotch_height: f64,
     /// Chest girth.
     pub chest: Girth,
@@ -77,7 +88,9 @@ pub struct Measurements {
 /// Finds the chest, waist and hip levels (see the module documentation for the rules).
 pub fn levels(body: &Mesh, regions: &BodyRegions) -> Levels {
     let m = &regions.landmarks;
-    let (lo, hi) = (m.crotch + LEVEL_STEP_MM, m.armpit() - LEVEL_STEP_MM);
+    // Below the lower armpit a raised arm cannot join the torso's loop.
+    let armpit = m.left_armpit.min(m.right_armpit);
+    let (lo, hi) = (m.crotch + LEVEL_STEP_MM, armpit - LEVEL_STEP_MM);
     let count = (((hi - lo) / LEVEL_STEP_MM) as usize).max(2);
     let zs: Vec<f64> = (0..count).map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64).collect();
     let loops = regions.torso_sections(body, &zs);
@@ -90,7 +103,6 @@ pub fn levels(body: &Mesh, regions: &BodyRegions) -> Levels {
             .map(|&(z, c)| (z, score(c)))
             .max_by(|a, b| a.1.total_cmp(&b.1))
     };
-    let armpit = m.armpit();
     let chest = best((armpit - 0.10 * m.height, armpit - 0.01 * m.height), &|c| c.tape_girth())
         .map_or(armpit - 0.05 * m.height, |b| b.0);
     let hip_band = (m.crotch, m.crotch + 0.35 * (armpit - m.crotch));
@@ -111,6 +123,24 @@ pub fn levels(body: &Mesh, regions: &BodyRegions) -> Levels {
     let interior = narrowest.filter(|&z| z > band.0 + LEVEL_STEP_MM && z < band.1 - LEVEL_STEP_MM);
     let waist = interior.unwrap_or(hip + 0.55 * (chest - hip));
     Levels { chest, waist, hip }
+}
+
+/// Where the girths of `body` at `levels` are unreliable: a hole in the scan crossing a
+/// level (its loop is closed with a straight edge across the hole).
+pub fn warnings(body: &Mesh, levels: &Levels) -> Vec<String> {
+    let names = ["chest", "waist", "hip"];
+    sections(body, &[levels.chest, levels.waist, levels.hip])
+        .iter()
+        .zip(names)
+        .filter(|(s, _)| s.bridged_gaps > 0)
+        .map(|(s, name)| {
+            format!(
+                "the {name} girth at z = {:.0} mm crosses {} hole(s) in the scan, bridged with \
+                 straight edges: it may read short",
+                s.height, s.bridged_gaps
+            )
+        })
+        .collect()
 }
 
 /// Measures `body` at `levels`; `torso` picks the torso loop of a section.

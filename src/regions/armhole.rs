@@ -30,8 +30,10 @@ const SEARCH_OUTWARD_MM: f64 = 150.0;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Armhole {
     /// The armpit: the lowest point where the arm meets the torso (mm, canonical frame).
+    #[serde(rename = "armpit_mm")]
     pub armpit: DVec3,
     /// The shoulder point (acromion): the outer end of the top of the shoulder.
+    #[serde(rename = "shoulder_point_mm")]
     pub shoulder_point: DVec3,
     /// Unit normal of the arm plate's plane (through both points), pointing away from the
     /// torso, into the arm.

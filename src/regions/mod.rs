@@ -37,22 +37,43 @@ pub enum Region {
     Head,
 }
 
+impl Region {
+    /// The label as text and JSON spell it: `torso`, `left_leg`, `right_arm`, ...
+    pub fn name(self) -> &'static str {
+        match self {
+            Region::Torso => "torso",
+            Region::LeftLeg => "left_leg",
+            Region::RightLeg => "right_leg",
+            Region::LeftArm => "left_arm",
+            Region::RightArm => "right_arm",
+            Region::Head => "head",
+        }
+    }
+}
+
 /// Landmark heights (mm, canonical frame) and the armholes.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Landmarks {
     /// Body height.
+    #[serde(rename = "height_mm")]
     pub height: f64,
     /// Where the legs join (to 0.1 mm): just above it the torso is one loop.
+    #[serde(rename = "crotch_mm")]
     pub crotch: f64,
     /// The narrowest level of the legs near the floor (the ankles): where the legs end.
+    #[serde(rename = "ankle_mm")]
     pub ankle: f64,
     /// Where the left arm joins the torso: the height of `left_armhole.armpit`.
+    #[serde(rename = "left_armpit_mm")]
     pub left_armpit: f64,
     /// Where the right arm joins the torso: the height of `right_armhole.armpit`.
+    #[serde(rename = "right_armpit_mm")]
     pub right_armpit: f64,
     /// The narrowest torso level between the armpits and the head.
+    #[serde(rename = "neck_mm")]
     pub neck: f64,
     /// The torso's centre line: its bounding-box centre (x) just below the armpits.
+    #[serde(rename = "centre_x_mm")]
     pub centre_x: f64,
     /// Where the left arm is cut off the torso (the subject's left, +X).
     pub left_armhole: Armhole,
@@ -87,11 +108,23 @@ pub enum RegionError {
         /// The height looked at.
         z: f64,
     },
-    /// The torso reaches the floor without splitting into two legs.
+    /// The legs never join below the torso.
     #[error(
-        "no crotch found: the legs do not separate below the torso (legs together, or a skirt?)"
+        "no crotch found: the legs followed up from the shins do not meet below mid-torso \
+         (is this one standing person?)"
     )]
     NoCrotch,
+    /// Not two legs at the shins.
+    #[error(
+        "no crotch found: {loops} loop(s) at z = {z:.0} mm (the shins) where two legs should \
+         be: scan standing with the feet apart (thighs may touch, shins must not)"
+    )]
+    NoLegs {
+        /// The height looked at.
+        z: f64,
+        /// The loops found there.
+        loops: usize,
+    },
     /// No arm loop below the armpits on one side.
     #[error(
         "no {side} arm found beside the torso (arms must hang clear of the torso, as in an A-pose)"
@@ -250,4 +283,24 @@ pub fn largest_with<'a>(
     region: Region,
 ) -> Option<&'a Contour> {
     section.loops.iter().zip(labels).find(|&(_, &r)| r == region).map(|(l, _)| l)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Region;
+
+    #[test]
+    fn labels_are_spelled_alike_in_text_and_json() {
+        let all = [
+            Region::Torso,
+            Region::LeftLeg,
+            Region::RightLeg,
+            Region::LeftArm,
+            Region::RightArm,
+            Region::Head,
+        ];
+        for r in all {
+            assert_eq!(serde_json::to_string(&r).unwrap(), format!("\"{}\"", r.name()));
+        }
+    }
 }

@@ -41,9 +41,10 @@ fn x_range(c: &Contour) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)))
 }
 
-/// The crotch between `below` (legs apart) and `above` (one torso loop around `inside`), by
-/// bisection to 0.1 mm, cutting only the part of the body between the two heights.
-fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, inside: DVec2) -> f64 {
+/// The crotch between `below` (the legs apart, their loops around `legs`) and `above` (one
+/// loop around both), by bisection to 0.1 mm, cutting only the part of the body between the
+/// two heights.
+fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, legs: [DVec2; 2]) -> f64 {
     let near = body.part(|tri| {
         let z = tri.map(|v| body.positions[v as usize].z);
         z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
@@ -51,10 +52,16 @@ fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, inside: DVec2) -> 
     while above - below > 0.1 {
         let mid = 0.5 * (below + above);
         let s = &sections(&near, &[mid])[0];
-        if loop_containing(s, inside).is_some() { above = mid } else { below = mid }
+        let [l, r] = legs.map(|c| loop_containing(s, c));
+        if l.is_some() && l == r { above = mid } else { below = mid }
     }
     above
 }
+
+/// Where the legs are picked up, as a fraction of the height: the shins, below any hand
+/// (fingertips hang at 0.38 of the stature or higher) and above the feet (the ankle is at
+/// 0.04, the knee at 0.28: Drillis and Contini).
+const SHIN_LEVEL: f64 = 0.15;
 
 /// The armpit between `below` (the arm's loop `arm` apart from the torso's loop `torso`)
 /// and `above` (joined), by bisection to 0.1 mm: the middle of the narrowest gap between the
@@ -118,35 +125,51 @@ pub(super) fn track(
         return Err(RegionError::NoTorso { z: z_of(seed) });
     }
     let up = follow(&sections, seed..n, 0);
-    let down = follow(&sections, (0..=seed).rev(), 0);
-    let &(crotch_i, crotch_k) = down.last().expect("the seed is tracked");
-    if crotch_i == 0 {
-        return Err(RegionError::NoCrotch);
+
+    // Legs, from their ends: the two largest loops at the shins (below any hand, above the
+    // feet), followed up until both land in one loop (the crotch: where the legs part) and
+    // down to the floor.
+    let shin = ((SHIN_LEVEL * height / step) as usize).min(n - 1);
+    let shins = &sections[shin].loops;
+    if shins.len() < 2 {
+        return Err(RegionError::NoLegs { z: z_of(shin), loops: shins.len() });
     }
+    let (left_k, right_k) =
+        if shins[0].centroid().x > shins[1].centroid().x { (0, 1) } else { (1, 0) };
+    let mut leg: Vec<[Option<usize>; 2]> = vec![[None, None]; n];
+    let mut apart = [shins[left_k].centroid(), shins[right_k].centroid()];
+    let mut crotch_i = None;
+    for i in shin..n {
+        let found = if i == shin {
+            [Some(left_k), Some(right_k)]
+        } else {
+            apart.map(|c| loop_containing(&sections[i], c))
+        };
+        match found {
+            [Some(l), Some(r)] if l == r => {
+                crotch_i = Some(i);
+                break;
+            }
+            [Some(l), Some(r)] => {
+                leg[i] = [Some(l), Some(r)];
+                apart = [sections[i].loops[l].centroid(), sections[i].loops[r].centroid()];
+            }
+            _ => break,
+        }
+    }
+    let Some(crotch_i) = crotch_i.filter(|&i| i <= seed) else {
+        return Err(RegionError::NoCrotch);
+    };
+    for (s, k) in [(0, left_k), (1, right_k)] {
+        for (i, k) in follow(&sections, (0..=shin).rev(), k) {
+            leg[i][s] = Some(k);
+        }
+    }
+    let crotch = refine_crotch(body, z_of(crotch_i - 1), z_of(crotch_i), apart);
+    let down = follow(&sections, (crotch_i..=seed).rev(), 0);
     let mut torso: Vec<Option<usize>> = vec![None; n];
     for &(i, k) in up.iter().chain(&down) {
         torso[i] = Some(k);
-    }
-
-    // Legs: below the crotch, the largest loop on each side under the torso, then followed down.
-    let crotch_loop = &sections[crotch_i].loops[crotch_k];
-    let mid = crotch_loop.centroid().x;
-    let (lo, hi) = x_range(crotch_loop);
-    let below = &sections[crotch_i - 1];
-    let under = |want_left: bool| {
-        below.loops.iter().position(|l| {
-            let c = l.centroid();
-            (c.x > mid) == want_left && c.x > lo && c.x < hi
-        })
-    };
-    let (Some(left_k), Some(right_k)) = (under(true), under(false)) else {
-        return Err(RegionError::NoCrotch);
-    };
-    let mut leg: Vec<[Option<usize>; 2]> = vec![[None, None]; n];
-    for (s, k) in [(0, left_k), (1, right_k)] {
-        for (i, k) in follow(&sections, (0..crotch_i).rev(), k) {
-            leg[i][s] = Some(k);
-        }
     }
 
     // Armpits: going up from the seed, the first level where a loop beside the torso on that
@@ -212,12 +235,7 @@ pub(super) fn track(
 
     let landmarks = Landmarks {
         height,
-        crotch: refine_crotch(
-            body,
-            z_of(crotch_i - 1),
-            z_of(crotch_i),
-            sections[crotch_i].loops[crotch_k].centroid(),
-        ),
+        crotch,
         ankle,
         left_armpit,
         right_armpit,

@@ -24,6 +24,10 @@ use serde::Serialize;
 use std::fmt;
 use std::str::FromStr;
 
+/// The heights a standing person can have (mm): from a small child to the tallest adults,
+/// with margin; the ranges in m, dm, cm and mm do not overlap, so the height tells the unit.
+pub const PERSON_HEIGHT_MM: (f64, f64) = (500.0, 2500.0);
+
 /// A length unit a scan may be stored in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
@@ -53,7 +57,7 @@ impl Units {
     pub fn from_height(height: f64) -> Option<Units> {
         [Units::M, Units::Dm, Units::Cm, Units::Mm]
             .into_iter()
-            .find(|u| (500.0..=2500.0).contains(&(height * u.mm())))
+            .find(|u| (PERSON_HEIGHT_MM.0..=PERSON_HEIGHT_MM.1).contains(&(height * u.mm())))
     }
 }
 
@@ -146,6 +150,29 @@ pub enum FrameError {
         height: f64,
         /// The up direction used.
         up: Direction,
+    },
+    /// `--units` makes the body a height no standing person has.
+    #[error(
+        "with --units {units} the body is {height_mm:.0} mm tall, and a standing person is \
+         500-2500 mm; {hint}"
+    )]
+    ImplausibleUnits {
+        /// The unit given.
+        units: Units,
+        /// The height it gives (mm).
+        height_mm: f64,
+        /// What to do instead.
+        hint: String,
+    },
+    /// `--up` puts the head below the feet, or makes the body wider than tall.
+    #[error("with --up {up} {problem}; {hint}")]
+    ImplausibleUp {
+        /// The up direction given.
+        up: Direction,
+        /// What no standing person looks like.
+        problem: String,
+        /// What to do instead.
+        hint: String,
     },
     /// `--facing` along the up axis.
     #[error("--facing {facing} is not horizontal when up is {up}")]
@@ -267,27 +294,79 @@ fn accumulate<const N: usize>(
         .reduce(|| [Moments::default(); N], |x, y| std::array::from_fn(|k| x[k].merge(y[k])))
 }
 
-/// Finds the canonical frame of `mesh` (a cleaned body), honouring `options`.
+/// The smallest ratio of height to the largest horizontal extent of a standing person: arms
+/// spread horizontally span about the stature (arm span / stature is 0.95-1.06 in adults),
+/// so a body wider than 1.25 times its height is lying down or seen along the wrong axis.
+const MIN_HEIGHT_TO_WIDTH: f64 = 0.8;
+
+/// Checks that `up` (given by the user) shows a standing person: the surface's centroid above
+/// mid-height (torso, arms and head carry more surface than the legs) and the body no wider
+/// than a person with spread arms. `detected` is what detection would have chosen.
+fn check_up(
+    up: Direction,
+    bounds: &Aabb,
+    centroid: DVec3,
+    detected: Direction,
+) -> Result<(), FrameError> {
+    let hint = if detected == up {
+        "check that the file holds one standing person".to_string()
+    } else {
+        format!("the body stands along {detected}: pass --up {detected} or leave --up out")
+    };
+    let axis = up.axis;
+    let height = bounds.size()[axis];
+    let width = (0..3).filter(|&a| a != axis).map(|a| bounds.size()[a]).fold(0.0, f64::max);
+    let mid = 0.5 * (bounds.min[axis] + bounds.max[axis]);
+    let problem = if (centroid[axis] < mid) != up.negative {
+        "the head is below the feet (the surface's centroid is below mid-height)".to_string()
+    } else if height < MIN_HEIGHT_TO_WIDTH * width {
+        format!(
+            "the body is {:.0}% as tall as it is wide, and a standing person is at least {:.0}%",
+            100.0 * height / width,
+            100.0 * MIN_HEIGHT_TO_WIDTH
+        )
+    } else {
+        return Ok(());
+    };
+    Err(FrameError::ImplausibleUp { up, problem, hint })
+}
+
+/// Finds the canonical frame of `mesh` (a cleaned body), honouring `options`; a given unit or
+/// up axis that makes no standing person is refused with the likely fix.
 pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, FrameError> {
     let bounds = mesh.bounds().unwrap_or(crate::mesh::Aabb { min: DVec3::ZERO, max: DVec3::ZERO });
+    let [all] = accumulate(mesh, |m: &mut [Moments; 1], p, a| m[0].add(p, a, DVec2::ZERO));
+    let centroid = all.mean().unwrap_or(bounds.min);
+    let axis = bounds.size().max_position();
+    let detected_up =
+        Direction { axis, negative: centroid[axis] < 0.5 * (bounds.min[axis] + bounds.max[axis]) };
     let up = match options.up {
-        Some(up) => up,
-        None => {
-            let axis = bounds.size().max_position();
-            let [all] = accumulate(mesh, |m: &mut [Moments; 1], p, a| m[0].add(p, a, DVec2::ZERO));
-            let centroid = all.mean().unwrap_or(bounds.min);
-            Direction {
-                axis,
-                negative: centroid[axis] < 0.5 * (bounds.min[axis] + bounds.max[axis]),
-            }
+        Some(up) => {
+            check_up(up, &bounds, centroid, detected_up)?;
+            up
         }
+        None => detected_up,
     };
     let u = up.vector();
     let (floor, top) =
         (bounds.min.dot(u).min(bounds.max.dot(u)), bounds.min.dot(u).max(bounds.max.dot(u)));
     let height = top - floor;
     let units = match options.units {
-        Some(units) => units,
+        Some(units) => {
+            let height_mm = height * units.mm();
+            if !(PERSON_HEIGHT_MM.0..=PERSON_HEIGHT_MM.1).contains(&height_mm) {
+                let hint = match Units::from_height(height) {
+                    Some(fit) => format!(
+                        "the file looks like {fit}: pass --units {fit} or leave --units out"
+                    ),
+                    None => {
+                        format!("no unit makes it a person along {up}: check --up and the file")
+                    }
+                };
+                return Err(FrameError::ImplausibleUnits { units, height_mm, hint });
+            }
+            units
+        }
         None => Units::from_height(height).ok_or(FrameError::UnknownUnits { height, up })?,
     };
 

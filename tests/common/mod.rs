@@ -184,3 +184,11 @@ pub fn largest_mirror_gap(mesh: &Mesh, axis: f64) -> f64 {
         })
         .fold(0.0, f64::max)
 }
+
+/// A generated customer's surface as a mesh (in the canonical frame, as the generator makes it).
+pub fn mesh_of(body: &sim::capture::SyntheticBody) -> Mesh {
+    Mesh::new(
+        body.surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
+        body.surface.triangles.clone(),
+    )
+}

@@ -298,6 +298,11 @@ impl CanBus {
         BusStats { elapsed: Instant::now().saturating_duration_since(self.origin), ..medium.stats }
     }
 
+    /// The log's first write error so far, if any (see [`CandumpLog::failure`]).
+    pub fn log_failure(&self) -> Option<String> {
+        self.shared.medium().log.as_ref().and_then(CandumpLog::failure)
+    }
+
     /// Writes out the log, if any; returns its first write error.
     pub fn flush_log(&self) -> std::io::Result<()> {
         self.shared.medium().log.as_mut().map_or(Ok(()), CandumpLog::flush)

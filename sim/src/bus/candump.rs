@@ -13,8 +13,8 @@
 //! `20000080#0000000000000000` for an error frame (CAN_ERR_FLAG | CAN_ERR_BUSERROR).
 //! can-utils (`canplayer`, `log2asc`) and python-can's `CanutilsLogReader` read it.
 //!
-//! Write errors do not stop the simulation: the first one is kept and returned by
-//! [`CandumpLog::flush`].
+//! Write errors do not stop the simulation: the first one is kept, shown by
+//! [`CandumpLog::failure`] as soon as it happens and returned by [`CandumpLog::flush`].
 
 use std::fmt::Write as _;
 use std::fs::File;
@@ -83,6 +83,11 @@ impl CandumpLog {
         if let Err(error) = result {
             self.error.get_or_insert(error);
         }
+    }
+
+    /// The first write error so far, if any (a full disk shows within one flush period).
+    pub fn failure(&self) -> Option<String> {
+        self.error.as_ref().map(ToString::to_string)
     }
 
     /// Writes out buffered lines; returns the first write error of the log, if any.

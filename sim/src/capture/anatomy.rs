@@ -9,6 +9,7 @@ use glam::{DQuat, DVec3};
 
 use super::params::BodyParams;
 use super::torso::Section;
+use super::warp::SpineWarp;
 
 /// Reference stature the proportions below were drawn for.
 const REF_HEIGHT: f64 = 1700.0;
@@ -140,6 +141,8 @@ pub(crate) struct Anatomy {
     pub legs: [Leg; 2],
     /// Neck and head.
     pub head: Head,
+    /// The spine's bend and twist and the head's turn.
+    pub warp: SpineWarp,
 }
 
 /// Reference torso knot: its shape for the 1700 mm reference body, and how much of its size
@@ -301,6 +304,13 @@ impl Anatomy {
             bust_protrusion,
             arms,
             legs,
+            warp: SpineWarp {
+                band: (z_waist, Z_SHOULDER_KNOT * h),
+                bend: p.pose.spine.lateral_bend_deg.to_radians(),
+                twist: p.pose.spine.twist_deg.to_radians(),
+                neck_axis: (head.neck_base.x, head.neck_base.y),
+                head_turn: p.pose.head_turn_deg.to_radians(),
+            },
             head,
         }
     }

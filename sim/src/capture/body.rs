@@ -7,6 +7,7 @@ use glam::DVec3;
 use super::anatomy::{Anatomy, Arm, Leg, SIDE_SIGN};
 use super::primitives::{Aabb, Ellipsoid, RoundCone, Tube, smooth_max, smooth_min};
 use super::torso::{Loft, ScaleProfile, Torso};
+use super::warp::{Segment, SpineWarp};
 
 /// The value the union starts from: points farther than this from every part read as this.
 const FAR_MM: f64 = 200.0;
@@ -116,11 +117,25 @@ struct Part {
     blend: f64,
     bound_ratio: f64,
     bound_offset: f64,
-    /// A point inside each member (seeds for the mesher).
+    /// A point inside each member (seeds for the mesher), as designed.
     inside: Vec<DVec3>,
+    /// What the part moves with when the spine bends and twists and the head turns.
+    segment: Segment,
+    /// Whether it is part of an arm (left out of the torso's girths).
+    arm: bool,
 }
 
 impl Part {
+    /// The part, moving with `segment`.
+    fn moving(self, segment: Segment) -> Part {
+        Part { segment, ..self }
+    }
+
+    /// The part, as part of an arm.
+    fn of_arm(self) -> Part {
+        Part { arm: true, ..self }
+    }
+
     /// A part of one shape with box `bounds`, a point `inside` it, blending by `blend`; its
     /// value is at least the distance to the box outside it.
     fn single(shape: Shape, bounds: Aabb, inside: DVec3, blend: f64) -> Part {
@@ -130,6 +145,8 @@ impl Part {
             bound_ratio: 1.0,
             bound_offset: 0.0,
             inside: vec![inside],
+            segment: Segment::Trunk,
+            arm: false,
         }
     }
 
@@ -186,6 +203,8 @@ impl Part {
 pub(crate) struct ImplicitBody {
     parts: Vec<Part>,
     loft: Loft,
+    /// The spine's and neck's pose.
+    pub warp: SpineWarp,
 }
 
 impl ImplicitBody {
@@ -226,15 +245,16 @@ impl ImplicitBody {
         }];
 
         let hd = &a.head;
-        parts.push(Part::cone(hd.neck_base, hd.r_neck, hd.neck_top, 0.92 * hd.r_neck, 25.0));
+        let mut head =
+            vec![Part::cone(hd.neck_base, hd.r_neck, hd.neck_top, 0.92 * hd.r_neck, 25.0)];
         let (cc, cr) = hd.cranium;
-        parts.push(Part::ellipsoid(Ellipsoid::aligned(cc, cr), cc, 25.0));
+        head.push(Part::ellipsoid(Ellipsoid::aligned(cc, cr), cc, 25.0));
         let (jc, jr) = hd.jaw;
-        parts.push(Part::ellipsoid(Ellipsoid::aligned(jc, jr), jc, 18.0));
+        head.push(Part::ellipsoid(Ellipsoid::aligned(jc, jr), jc, 18.0));
         let (na, nra, nb, nrb) = hd.nose;
-        parts.push(Part::cone(na, nra, nb, nrb, 8.0));
+        head.push(Part::cone(na, nra, nb, nrb, 8.0));
         let nostrils = nb + DVec3::new(0.0, 0.6 * nrb, -0.7 * nrb);
-        parts.push(Part::ellipsoid(
+        head.push(Part::ellipsoid(
             Ellipsoid::aligned(nostrils, DVec3::new(1.6, 0.9, 0.8) * nrb),
             nostrils,
             6.0,
@@ -244,37 +264,80 @@ impl ImplicitBody {
             let c = ec * DVec3::new(sg, 1.0, 1.0);
             Part::ellipsoid(Ellipsoid::aligned(c, er), c, 4.0)
         });
-        let pairs = std::iter::once((left_ear, right_ear))
-            .chain(arm_parts(&a.arms[0]).into_iter().zip(arm_parts(&a.arms[1])))
-            .chain(leg_parts(&a.legs[0]).into_iter().zip(leg_parts(&a.legs[1])));
-        parts.extend(pairs.map(|(left, right)| left.with_mirror(right)));
-        ImplicitBody { parts, loft }
+        head.push(left_ear.with_mirror(right_ear));
+        parts.extend(head.into_iter().map(|p| p.moving(Segment::Head)));
+        let arms = arm_parts(&a.arms[0]).into_iter().zip(arm_parts(&a.arms[1]));
+        parts.extend(arms.map(|(left, right)| left.with_mirror(right).of_arm()));
+        let legs = leg_parts(&a.legs[0]).into_iter().zip(leg_parts(&a.legs[1]));
+        parts.extend(legs.map(|(left, right)| left.with_mirror(right).moving(Segment::Pelvis)));
+        ImplicitBody { parts, loft, warp: a.warp }
     }
 
     /// Signed distance estimate of the body surface at `p` (negative inside). Parts are
     /// blended in a fixed order; a part is skipped only when its lower bound proves it
     /// cannot change the running value, so the result does not depend on the skipping.
     pub fn value(&self, p: DVec3) -> f64 {
+        self.union(p, true)
+    }
+
+    /// [`Self::value`] of the body without its arms: what a tape around the torso meets,
+    /// even where an arm rests on it.
+    pub fn value_without_arms(&self, p: DVec3) -> f64 {
+        self.union(p, false)
+    }
+
+    /// The union of the parts (with the arms or not) at `p`, each part evaluated where its
+    /// segment's warp brings `p` back to the design.
+    fn union(&self, p: DVec3, arms: bool) -> f64 {
+        let local = |segment: Segment| self.warp.inverse(segment, p);
+        let (trunk, head) = (local(Segment::Trunk), local(Segment::Head));
         let mut d = FAR_MM;
-        for part in &self.parts {
-            if part.lower_bound(p) >= d + part.blend {
+        for part in self.parts.iter().filter(|part| arms || !part.arm) {
+            let q = match part.segment {
+                Segment::Pelvis => p,
+                Segment::Trunk => trunk,
+                Segment::Head => head,
+            };
+            if part.lower_bound(q) >= d + part.blend {
                 continue;
             }
-            d = smooth_min(d, part.distance(p), part.blend);
+            d = smooth_min(d, part.distance(q), part.blend);
         }
         d
     }
 
-    /// The centre (x, y) of the torso's section at height `z`: where girth rays start.
+    /// The centre (x, y) of the torso's section at height `z`: where girth rays start (the
+    /// loft's centre line, moved with the spine).
     pub fn torso_centre(&self, z: f64) -> (f64, f64) {
-        (0.0, self.loft.at(z).centre_y())
+        if self.warp.spine_is_straight() {
+            return (0.0, self.loft.at(z).centre_y());
+        }
+        let axis = |zl: f64| {
+            let c = self.loft.at(zl).centre_y();
+            self.warp.forward(Segment::Trunk, DVec3::new(0.0, c, zl))
+        };
+        // The design height whose centre-line point lands at height z (monotone in it).
+        let (mut lo, mut hi) = (z - CENTRE_SEARCH_MM, z + CENTRE_SEARCH_MM);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if axis(mid).z < z { lo = mid } else { hi = mid }
+        }
+        let c = axis(0.5 * (lo + hi));
+        (c.x, c.y)
     }
 
     /// One point inside each part: every part of the surface is reached from one of them.
     pub fn interior_points(&self) -> Vec<DVec3> {
-        self.parts.iter().flat_map(|p| p.inside.iter().copied()).collect()
+        self.parts
+            .iter()
+            .flat_map(|p| p.inside.iter().map(|&q| self.warp.forward(p.segment, q)))
+            .collect()
     }
 }
+
+/// How far (mm) a height on the spine's centre line can move with the bend: the band's
+/// length times 1 - cos of the largest bend, with margin.
+const CENTRE_SEARCH_MM: f64 = 200.0;
 
 /// The parts of an arm: trapezius, deltoid, upper arm, forearm, palm, fingers, thumb.
 fn arm_parts(arm: &Arm) -> Vec<Part> {

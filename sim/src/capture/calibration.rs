@@ -45,12 +45,23 @@ fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
-/// Boundary points of the torso loop at height `z`: along each of [`RAYS`] rays from the torso
-/// centre, the first point where the surface is left. `None` if the centre is outside or a ray
+/// Boundary points of the torso loop at height `z`, arms left out (a tape passes between an
+/// arm and the torso, even where the arm rests on it): along each of [`RAYS`] rays from the
+/// torso centre, the first point where the surface is left. `None` if the centre is outside or a ray
 /// never leaves.
 pub(crate) fn torso_loop(body: &ImplicitBody, z: f64) -> Option<Vec<[f64; 2]>> {
-    let (cx, cy) = body.torso_centre(z);
-    if body.value(DVec3::new(cx, cy, z)) >= 0.0 {
+    loop_around(body, body.torso_centre(z), z)
+}
+
+/// Boundary points of the loop at height `z` around the point (`cx`, `cy`), arms left out:
+/// along each of [`RAYS`] rays from it, the first point where the surface is left. `None` if
+/// the point is outside or a ray never leaves.
+pub(crate) fn loop_around(
+    body: &ImplicitBody,
+    (cx, cy): (f64, f64),
+    z: f64,
+) -> Option<Vec<[f64; 2]>> {
+    if body.value_without_arms(DVec3::new(cx, cy, z)) >= 0.0 {
         return None;
     }
     (0..RAYS)
@@ -58,7 +69,7 @@ pub(crate) fn torso_loop(body: &ImplicitBody, z: f64) -> Option<Vec<[f64; 2]>> {
         .map(|i| {
             let angle = i as f64 / RAYS as f64 * std::f64::consts::TAU;
             let (s, c) = angle.sin_cos();
-            let at = |r: f64| body.value(DVec3::new(cx + r * c, cy + r * s, z));
+            let at = |r: f64| body.value_without_arms(DVec3::new(cx + r * c, cy + r * s, z));
             let mut r = 0.0;
             let mut value = at(r);
             while r < RAY_REACH {
@@ -114,6 +125,11 @@ fn convex_hull(pts: &[[f64; 2]]) -> Vec<[f64; 2]> {
         hull.pop();
     }
     hull
+}
+
+/// Tape girth of the loop at height `z` around (`cx`, `cy`), arms left out.
+pub(crate) fn tape_girth_around(body: &ImplicitBody, centre: (f64, f64), z: f64) -> Option<f64> {
+    loop_around(body, centre, z).map(|pts| perimeter(&convex_hull(&pts)))
 }
 
 /// Tape and contour girth of the torso loop at height `z`.

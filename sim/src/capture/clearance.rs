@@ -1,12 +1,15 @@
-//! Clearance rules: the arms must stay apart from the torso where the girths are measured
-//! (so the chest, waist and hip sections hold the torso alone) and the hands apart from the
-//! thighs. Checked on the designed anatomy, before calibration.
+//! Clearance rules: where the girths are measured, an arm either stays apart from the torso
+//! (so a scan shows a clear gap) or rests on it (a scan shows them touching); a gap of a few
+//! millimetres, which a scanner blurs, is refused, and so is an arm sunk into the torso. The
+//! hands stay apart from the thighs. Checked on the designed anatomy, before calibration
+//! (the girths a tape measures leave the arms out either way: see `ImplicitBody::value_without_arms`).
 
 use glam::DVec3;
 
 use super::anatomy::{Anatomy, SIDE_NAME};
 use super::params::{BodyParams, ParamError, arm_field};
 use super::torso::Loft;
+use super::warp::Segment;
 
 /// Least gap (mm) between an arm and the torso at the girth levels, and between a hand and a
 /// thigh: more than the widest blend below the shoulder (the upper arm's, 18 mm), so the arms
@@ -38,6 +41,11 @@ fn torso_clearance(a: &Anatomy, z: f64, from: DVec3, to: DVec3, radius: f64) -> 
     Some(r - reach - r_eff)
 }
 
+/// How deep (mm) an arm resting on the torso may press into it: soft tissue gives a little.
+pub(crate) const MAX_PRESS_MM: f64 = 8.0;
+/// How deep an arm put to rest on the torso presses into it (mm).
+const REST_PRESS_MM: f64 = 2.0;
+
 /// Distance between the point `p` and the segment `a`-`b`.
 fn point_segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
     let ab = b - a;
@@ -56,23 +64,14 @@ struct Violation {
 
 /// The first clearance violation of the arms on `sides`: an arm segment crossing a girth level
 /// too close to the torso, or a hand too close to a thigh.
-fn first_violation(a: &Anatomy, sides: &[usize]) -> Option<Violation> {
+fn first_violation(a: &Anatomy, sides: &[usize], resting_allowed: bool) -> Option<Violation> {
     for &side in sides {
         let arm = &a.arms[side];
-        let segments = [
-            ("upper arm", arm.shoulder, arm.elbow, arm.r_upper),
-            ("forearm", arm.elbow, arm.wrist, arm.r_forearm),
-            ("hand", arm.wrist, arm.fingertip, 0.24 * arm.hand_length),
-        ];
-        for z in a.levels {
-            for (part, from, to, radius) in segments {
-                match torso_clearance(a, z, from, to, radius) {
-                    Some(gap) if gap < LIMB_CLEARANCE_MM => {
-                        return Some(Violation { side, part, obstacle: "torso", z, gap });
-                    }
-                    _ => {}
-                }
-            }
+        if let Some(closest) = closest_to_torso(a, side)
+            && !(resting_allowed && (-MAX_PRESS_MM..=0.0).contains(&closest.gap))
+            && closest.gap < LIMB_CLEARANCE_MM
+        {
+            return Some(closest);
         }
         let hand_points = [
             (arm.wrist, arm.r_wrist),
@@ -81,6 +80,8 @@ fn first_violation(a: &Anatomy, sides: &[usize]) -> Option<Violation> {
         ];
         for leg in &a.legs {
             for (point, radius) in hand_points {
+                // The hand moves with the spine, the thigh does not.
+                let point = a.warp.forward(Segment::Trunk, point);
                 let gap = point_segment_distance(point, leg.hip, leg.knee) - leg.r_hip - radius;
                 if gap < LIMB_CLEARANCE_MM {
                     return Some(Violation {
@@ -97,18 +98,51 @@ fn first_violation(a: &Anatomy, sides: &[usize]) -> Option<Violation> {
     None
 }
 
+/// Where the arm on `side` comes closest to the torso at the girth levels (its gap negative
+/// where it overlaps), if it crosses any.
+fn closest_to_torso(a: &Anatomy, side: usize) -> Option<Violation> {
+    let arm = &a.arms[side];
+    let segments = [
+        ("upper arm", arm.shoulder, arm.elbow, arm.r_upper),
+        ("forearm", arm.elbow, arm.wrist, arm.r_forearm),
+        ("hand", arm.wrist, arm.fingertip, 0.24 * arm.hand_length),
+    ];
+    a.levels
+        .iter()
+        .flat_map(|&z| segments.iter().map(move |s| (z, s)))
+        .filter_map(|(z, &(part, from, to, radius))| {
+            let gap = torso_clearance(a, z, from, to, radius)?;
+            Some(Violation { side, part, obstacle: "torso", z, gap })
+        })
+        .min_by(|x, y| x.gap.total_cmp(&y.gap))
+}
+
+/// Lowers the arm on `side` until it rests on the torso (pressing [`REST_PRESS_MM`] into
+/// it at the girth level where it comes closest); unchanged if no abduction does.
+pub(crate) fn rest_arm_on_torso(p: &mut BodyParams, side: usize) {
+    let resting = (0..=400).rev().map(|k| f64::from(k) * 0.25).find(|&deg| {
+        let mut q = p.clone();
+        *abduction_mut(&mut q, side) = deg;
+        closest_to_torso(&Anatomy::new(&q), side).is_some_and(|c| c.gap <= -REST_PRESS_MM)
+    });
+    if let Some(deg) = resting {
+        *abduction_mut(p, side) = deg;
+    }
+}
+
 /// The abduction of the arm on `side`.
 fn abduction_mut(p: &mut BodyParams, side: usize) -> &mut f64 {
     if side == 0 { &mut p.pose.left_arm.abduction_deg } else { &mut p.pose.right_arm.abduction_deg }
 }
 
-/// The least abduction (whole degrees, at most 100) that clears the arm on `side`.
+/// The least abduction (whole degrees, at most 100) at which the arm on `side` clears the
+/// torso (not resting on it) and its hand the thighs.
 fn least_clear_abduction(p: &BodyParams, side: usize) -> Option<f64> {
     let mut q = p.clone();
     let mut deg = abduction_mut(&mut q, side).ceil();
     while deg <= 100.0 {
         *abduction_mut(&mut q, side) = deg;
-        if first_violation(&Anatomy::new(&q), &[side]).is_none() {
+        if first_violation(&Anatomy::new(&q), &[side], false).is_none() {
             return Some(deg);
         }
         deg += 1.0;
@@ -117,10 +151,10 @@ fn least_clear_abduction(p: &BodyParams, side: usize) -> Option<f64> {
 }
 
 /// Checks that each arm clears the torso by [`LIMB_CLEARANCE_MM`] at the chest, waist and hip
-/// levels and each hand clears both thighs; the error names the arm's abduction and suggests
-/// a value that clears.
+/// levels or rests on it (pressing at most [`MAX_PRESS_MM`] into it), and that each hand
+/// clears both thighs; the error names the arm's abduction and suggests a value that clears.
 pub(crate) fn check_clearances(a: &Anatomy, p: &BodyParams) -> Result<(), ParamError> {
-    let Some(v) = first_violation(a, &[0, 1]) else {
+    let Some(v) = first_violation(a, &[0, 1], true) else {
         return Ok(());
     };
     let mut q = p.clone();
@@ -143,8 +177,8 @@ pub(crate) fn check_clearances(a: &Anatomy, p: &BodyParams) -> Result<(), ParamE
     })
 }
 
-/// Raises each arm's abduction to the least value that passes the clearance checks (if one
-/// up to 100 degrees does); used by [`BodyParams::random`].
+/// Raises each arm's abduction to the least value at which it clears the torso and the hand
+/// the thighs (if one up to 100 degrees does); used by [`BodyParams::random`].
 pub(crate) fn open_arms_until_clear(p: &mut BodyParams) {
     for side in 0..2 {
         if let Some(deg) = least_clear_abduction(p, side) {

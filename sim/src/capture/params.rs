@@ -41,7 +41,8 @@ pub struct BodyParams {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ArmPose {
     /// Angle between the upper arm and the vertical in the frontal plane: 0 = hanging,
-    /// 90 = horizontal, A-pose 35 ..= 45 (10 ..= 100).
+    /// 90 = horizontal, A-pose 35 ..= 45 (0 ..= 100). Near the body the arm must either clear
+    /// the torso or rest on it (see [`BodyParams::validate`]).
     pub abduction_deg: f64,
     /// Forward swing of the arm about the shoulders' left-right axis; positive moves the hand
     /// forward (to -Y) (-30 ..= 60).
@@ -57,10 +58,22 @@ pub struct ArmPose {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LegPose {
     /// Angle between the leg and the vertical in the frontal plane, the foot moving outward
-    /// (2 ..= 20). Both feet stay flat on the floor: the leg is as long as the pose needs.
+    /// (2 ..= 20; at 2 the legs stand together, the thighs touching below the crotch). Both
+    /// feet stay flat on the floor: the leg is as long as the pose needs.
     pub abduction_deg: f64,
     /// Outward turn of the foot about the vertical (-10 ..= 30).
     pub toe_out_deg: f64,
+}
+
+/// Pose of the spine between the waist and the shoulders. Angles in degrees.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SpinePose {
+    /// Sideways bend (lateral flexion) over the spine from the waist to the shoulders;
+    /// positive bends towards the subject's left (+X) (-12 ..= 12).
+    pub lateral_bend_deg: f64,
+    /// Twist (axial rotation) over the same band; positive turns the shoulders towards the
+    /// subject's left, counter-clockwise seen from above (-15 ..= 15).
+    pub twist_deg: f64,
 }
 
 /// Joint angles of the standing pose, per side. "Left" is the subject's left (+X).
@@ -74,6 +87,11 @@ pub struct Pose {
     pub left_leg: LegPose,
     /// The subject's right leg.
     pub right_leg: LegPose,
+    /// The spine's bend and twist.
+    pub spine: SpinePose,
+    /// Turn of the head about the neck; positive turns the face towards the subject's left
+    /// (-70 ..= 70).
+    pub head_turn_deg: f64,
 }
 
 impl Pose {
@@ -87,7 +105,14 @@ impl Pose {
             shoulder_elevation_mm: 0.0,
         };
         let leg = LegPose { abduction_deg: 6.0, toe_out_deg: 7.0 };
-        Pose { left_arm: arm, right_arm: arm, left_leg: leg, right_leg: leg }
+        Pose {
+            left_arm: arm,
+            right_arm: arm,
+            left_leg: leg,
+            right_leg: leg,
+            spine: SpinePose::default(),
+            head_turn_deg: 0.0,
+        }
     }
 
     /// An asymmetric pose: the left arm raised to near horizontal and swung forward, the right
@@ -294,7 +319,7 @@ impl BodyParams {
         check_range("resolution_mm", self.resolution_mm, 2.0, 12.0, " mm", "")?;
         for (side, arm) in [("left", &self.pose.left_arm), ("right", &self.pose.right_arm)] {
             let f = |name: &'static str| arm_field(side, name);
-            check_range(f("abduction_deg"), arm.abduction_deg, 10.0, 100.0, " deg", "")?;
+            check_range(f("abduction_deg"), arm.abduction_deg, 0.0, 100.0, " deg", "")?;
             check_range(f("flexion_deg"), arm.flexion_deg, -30.0, 60.0, " deg", "")?;
             check_range(f("elbow_flexion_deg"), arm.elbow_flexion_deg, 0.0, 60.0, " deg", "")?;
             check_range(
@@ -311,6 +336,17 @@ impl BodyParams {
             check_range(f("abduction_deg"), leg.abduction_deg, 2.0, 20.0, " deg", "")?;
             check_range(f("toe_out_deg"), leg.toe_out_deg, -10.0, 30.0, " deg", "")?;
         }
+        let spine = &self.pose.spine;
+        check_range(
+            "pose.spine.lateral_bend_deg",
+            spine.lateral_bend_deg,
+            -12.0,
+            12.0,
+            " deg",
+            "",
+        )?;
+        check_range("pose.spine.twist_deg", spine.twist_deg, -15.0, 15.0, " deg", "")?;
+        check_range("pose.head_turn_deg", self.pose.head_turn_deg, -70.0, 70.0, " deg", "")?;
         Ok(())
     }
 
@@ -352,7 +388,7 @@ impl BodyParams {
             leg_length_mm: leg,
             bust_prominence: bust,
             resolution_mm: DEFAULT_RESOLUTION_MM,
-            pose: Pose { left_arm, right_arm, left_leg, right_leg },
+            pose: Pose { left_arm, right_arm, left_leg, right_leg, ..Pose::a_pose() },
         };
         params.waist_girth_mm =
             params.waist_girth_mm.clamp(0.57 * params.chest_girth_mm, 1.12 * params.chest_girth_mm);
@@ -360,6 +396,24 @@ impl BodyParams {
             params.hip_girth_mm.clamp(0.82 * params.chest_girth_mm, 1.38 * params.chest_girth_mm);
         clearance::open_arms_until_clear(&mut params);
         params
+    }
+}
+
+impl BodyParams {
+    /// These parameters with each arm raised, if needed, until it clears the torso at the
+    /// girth levels by the clearance rule's margin and its hand clears the thighs.
+    pub fn with_arms_clear(mut self) -> Self {
+        clearance::open_arms_until_clear(&mut self);
+        self
+    }
+
+    /// These parameters with the arm on the subject's left (`left`) or right side lowered
+    /// until it rests on the torso, as an arm hanging at the side does: it touches the torso
+    /// at the girth level where it comes closest. Passes [`BodyParams::validate`] when the
+    /// hand then clears the thighs.
+    pub fn with_arm_resting_on_torso(mut self, left: bool) -> Self {
+        clearance::rest_arm_on_torso(&mut self, if left { 0 } else { 1 });
+        self
     }
 }
 

@@ -6,6 +6,10 @@ use glam::DVec3;
 use super::anatomy::{Anatomy, SIDE_SIGN};
 use super::body::ImplicitBody;
 use super::calibration::{Calibrated, SectionMeasure};
+use super::warp::Segment;
+
+/// A signed distance field (negative inside).
+type Field<'a> = &'a dyn Fn(DVec3) -> f64;
 
 /// A horizontal girth level.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -87,9 +91,9 @@ pub struct GroundTruth {
 }
 
 /// The surface point where a walk from `inside` along `dir` first leaves the body.
-fn exit_point(body: &ImplicitBody, inside: DVec3, dir: DVec3) -> DVec3 {
+fn exit_point(body: Field, inside: DVec3, dir: DVec3) -> DVec3 {
     let dir = dir.normalize();
-    let at = |t: f64| body.value(inside + dir * t);
+    let at = |t: f64| body(inside + dir * t);
     let (mut lo, mut hi) = (0.0, 0.5);
     while at(hi) < 0.0 && hi < 3000.0 {
         lo = hi;
@@ -108,9 +112,9 @@ fn exit_point(body: &ImplicitBody, inside: DVec3, dir: DVec3) -> DVec3 {
 
 /// The surface point where a walk from the outside point `outside` along `dir` first enters
 /// the body, if within `reach` mm.
-fn entry_point(body: &ImplicitBody, outside: DVec3, dir: DVec3, reach: f64) -> Option<DVec3> {
+fn entry_point(body: Field, outside: DVec3, dir: DVec3, reach: f64) -> Option<DVec3> {
     let dir = dir.normalize();
-    let at = |t: f64| body.value(outside + dir * t);
+    let at = |t: f64| body(outside + dir * t);
     let mut t = 0.0;
     while t < reach {
         let next = t + 0.5;
@@ -131,17 +135,26 @@ fn entry_point(body: &ImplicitBody, outside: DVec3, dir: DVec3, reach: f64) -> O
     None
 }
 
-/// The armpit of `side`: in the shoulder's frontal plane, between the torso and the arm at
-/// the chest level, the highest point the gap reaches.
-fn armpit(body: &ImplicitBody, a: &Anatomy, side: usize) -> DVec3 {
+/// The armpit of `side`: in the shoulder's frontal plane, between the torso and the arm, the
+/// highest point the gap reaches; looked for from the chest level, or from the first level
+/// above it where the arm does not rest on the torso.
+fn armpit(body: Field, a: &Anatomy, side: usize) -> DVec3 {
     let arm = &a.arms[side];
     let sg = SIDE_SIGN[side];
-    let z0 = a.levels[2];
     let y = arm.shoulder.y;
-    let torso_side = exit_point(body, DVec3::new(0.0, y, z0), DVec3::X * sg);
-    // Where the arm begins beyond the gap (or a hand's breadth out when the arm is raised).
-    let gap_end = entry_point(body, torso_side + DVec3::X * sg, DVec3::X * sg, 300.0)
-        .unwrap_or(torso_side + DVec3::X * (sg * 100.0));
+    let gap_at = |z0: f64| {
+        let torso_side = exit_point(body, DVec3::new(0.0, y, z0), DVec3::X * sg);
+        // Where the arm begins beyond the gap (or a hand's breadth out when it is raised).
+        let gap_end = entry_point(body, torso_side + DVec3::X * sg, DVec3::X * sg, 300.0)
+            .unwrap_or(torso_side + DVec3::X * (sg * 100.0));
+        (torso_side, gap_end)
+    };
+    let levels = (0..).map(|k| a.levels[2] + GAP_SEARCH_STEP_MM * f64::from(k));
+    let (torso_side, gap_end) = levels
+        .take_while(|&z| z < arm.shoulder.z)
+        .map(gap_at)
+        .find(|(t, g)| t.distance(*g) > GAP_SEARCH_STEP_MM)
+        .unwrap_or_else(|| gap_at(a.levels[2]));
     let roof = |t: f64| {
         let p = torso_side.lerp(gap_end, t);
         entry_point(body, p, DVec3::Z, a.height).map_or(f64::MAX, |q| q.z)
@@ -168,44 +181,76 @@ fn armpit(body: &ImplicitBody, a: &Anatomy, side: usize) -> DVec3 {
     entry_point(body, p, DVec3::Z, a.height).unwrap_or(p)
 }
 
+/// Step (mm) of the search upward for a level where an arm resting on the torso leaves a gap.
+const GAP_SEARCH_STEP_MM: f64 = 5.0;
+
+/// The highest surface point of the part around `inside` (the head, however it is tilted):
+/// the highest of the exits straight up from points on a grid around `inside`, refined.
+fn highest_point(body: Field, inside: DVec3) -> DVec3 {
+    let up = |x: f64, y: f64| exit_point(body, DVec3::new(x, y, inside.z), DVec3::Z);
+    let mut best = up(inside.x, inside.y);
+    let mut step = TOP_SEARCH_MM;
+    while step > 0.05 {
+        let around = (-1..=1).flat_map(|i| (-1..=1).map(move |j| (i, j)));
+        let (x, y) = (best.x, best.y);
+        let candidate = around
+            .map(|(i, j)| up(x + f64::from(i) * step, y + f64::from(j) * step))
+            .max_by(|a, b| a.z.total_cmp(&b.z))
+            .unwrap_or(best);
+        if candidate.z > best.z { best = candidate } else { step *= 0.5 }
+    }
+    best
+}
+
+/// First step (mm) of the search for the top of a tilted head: a fraction of its radius.
+const TOP_SEARCH_MM: f64 = 16.0;
+
 /// Tape and contour girth of a calibrated level as a [`GirthLevel`].
 fn girth_level(body: &ImplicitBody, z: f64, m: &SectionMeasure) -> GirthLevel {
     let (x, y) = body.torso_centre(z);
     GirthLevel { z_mm: z, tape_girth_mm: m.tape, contour_girth_mm: m.contour, centre_xy_mm: [x, y] }
 }
 
-/// Measures the ground truth of the calibrated body.
+/// Measures the ground truth of the calibrated body. Landmarks of the trunk and arms are
+/// found in the trunk's own frame (as designed, before the spine bends and twists) and moved
+/// with it; those of the head in the head's; the legs' where they stand.
 pub(crate) fn ground_truth(a: &Anatomy, cal: &Calibrated) -> GroundTruth {
     let body = &cal.body;
+    let world = |q: DVec3| body.value(q);
+    let in_frame = |segment: Segment| move |q: DVec3| body.value(body.warp.forward(segment, q));
+    let (trunk, head) = (in_frame(Segment::Trunk), in_frame(Segment::Head));
+    let on_trunk = |q: DVec3| body.warp.forward(Segment::Trunk, q).to_array();
     let sides: [SideLandmarks; 2] = std::array::from_fn(|side| {
         let arm = &a.arms[side];
         let leg = &a.legs[side];
         let above = DVec3::new(arm.acromion.x, arm.acromion.y, a.height + 10.0);
-        let acromion = entry_point(body, above, DVec3::NEG_Z, a.height).unwrap_or(arm.acromion);
+        let acromion = entry_point(&trunk, above, DVec3::NEG_Z, a.height).unwrap_or(arm.acromion);
         let [along, _, _] = arm.hand_axes;
         let fingers = arm.wrist + along * (0.7 * arm.hand_length);
         let lf = leg.foot_length;
         let heel_centre = leg.foot_point(-0.12 * lf, 0.0, 0.11 * lf);
         let toes_centre = leg.foot_point(0.62 * lf, -0.08 * leg.foot_width, 0.06 * lf);
         SideLandmarks {
-            acromion: acromion.to_array(),
-            armpit: armpit(body, a, side).to_array(),
-            shoulder_joint: arm.shoulder.to_array(),
-            elbow_joint: arm.elbow.to_array(),
-            wrist_joint: arm.wrist.to_array(),
-            fingertip: exit_point(body, fingers, along).to_array(),
+            acromion: on_trunk(acromion),
+            armpit: on_trunk(armpit(&trunk, a, side)),
+            shoulder_joint: on_trunk(arm.shoulder),
+            elbow_joint: on_trunk(arm.elbow),
+            wrist_joint: on_trunk(arm.wrist),
+            fingertip: on_trunk(exit_point(&trunk, fingers, along)),
             hip_joint: leg.hip.to_array(),
             knee_joint: leg.knee.to_array(),
             ankle_joint: leg.ankle.to_array(),
-            heel: exit_point(body, heel_centre, -leg.foot_forward).to_array(),
-            toe_tip: exit_point(body, toes_centre, leg.foot_forward).to_array(),
+            heel: exit_point(&world, heel_centre, -leg.foot_forward).to_array(),
+            toe_tip: exit_point(&world, toes_centre, leg.foot_forward).to_array(),
             sole_centre: leg.foot_point(0.2 * lf, 0.0, 0.0).to_array(),
         }
     });
     let hd = &a.head;
     let (cranium, _) = hd.cranium;
     let (_, _, nose_tip, _) = hd.nose;
-    let head_top = exit_point(body, cranium, DVec3::Z);
+    let on_head = |q: DVec3| body.warp.forward(Segment::Head, q);
+    let head_top = highest_point(&world, on_head(cranium));
+    let nose = on_head(exit_point(&head, nose_tip, DVec3::NEG_Y));
     let [hip, waist, chest] =
         std::array::from_fn(|l| girth_level(body, a.levels[l], &cal.sections[l]));
     GroundTruth {
@@ -217,8 +262,8 @@ pub(crate) fn ground_truth(a: &Anatomy, cal: &Calibrated) -> GroundTruth {
         shoulder_width_mm: (sides[0].acromion[0] - sides[1].acromion[0]).abs(),
         landmarks: Landmarks {
             head_top: head_top.to_array(),
-            nose_tip: exit_point(body, nose_tip, DVec3::NEG_Y).to_array(),
-            neck_base: hd.neck_base.to_array(),
+            nose_tip: nose.to_array(),
+            neck_base: on_head(hd.neck_base).to_array(),
             crotch: [0.0, cal.crotch.0, cal.crotch.1],
             left: sides[0],
             right: sides[1],

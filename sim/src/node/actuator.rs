@@ -257,6 +257,18 @@ impl ActuatorSim {
         }
     }
 
+    /// Repairs the mechanism and the encoder (a technician freed the jam, replaced the
+    /// encoder): the panel holds where it is; a latched fault stays until a FaultReset.
+    pub fn repair(&mut self, now: Instant) {
+        if self.jammed_at.is_some() {
+            let position = self.position(now);
+            self.jammed_at = None;
+            self.plan(now, Profile::hold(position));
+        }
+        self.encoder_broken = false;
+        self.encoder_reported = false;
+    }
+
     /// The feedback position: the panel's position plus `noise` (mm), to 0.01 mm; `None`
     /// when not homed.
     pub fn measured(&self, now: Instant, noise: f64) -> Option<Position> {

@@ -235,6 +235,23 @@ impl Node {
         }
     }
 
+    /// Repairs one of its actuators at `now` (see [`ActuatorFault`]): no longer jammed, its
+    /// encoder working; latched faults stay until a FaultReset.
+    pub fn repair(&mut self, now: Instant, actuator: Actuator) {
+        self.advance(now);
+        if let Some(a) = self.actuators.get_mut(actuator.index()) {
+            a.repair(now);
+        }
+    }
+
+    /// The simulator itself stood still for `lost` (its process was descheduled): a real
+    /// node never does, so its watchdog does not count that time against the host.
+    pub fn excuse(&mut self, lost: Duration) {
+        if let Some((at, version)) = self.host {
+            self.host = Some((at + lost, version));
+        }
+    }
+
     /// Lets time pass up to `now`: motion, homing, monitoring, the watchdog and cyclic
     /// frames.
     pub fn tick(&mut self, now: Instant) {

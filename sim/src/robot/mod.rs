@@ -200,6 +200,15 @@ impl SimulatedForm {
         true
     }
 
+    /// Repairs an actuator now (a technician freed a jam or replaced an encoder; the latched
+    /// fault stays until the host's FaultReset); `false` if the form has no such actuator.
+    pub fn repair(&self, actuator: &str) -> bool {
+        let Some((node, index)) = self.description.locate(actuator) else { return false };
+        let Some(shared) = self.node(node) else { return false };
+        lock(shared).node.repair(Instant::now(), index);
+        true
+    }
+
     /// Reboots a node's controller now; `false` if the form has no such node.
     pub fn reboot(&self, node: NodeId) -> bool {
         let Some(shared) = self.node(node) else { return false };

@@ -12,6 +12,24 @@ use super::node_sim::NodeSim;
 use crate::bus::can::{CanPort, CanSender};
 use crate::bus::serial::SerialLine;
 
+/// The longest a runner may go between two wakes before the gap counts as the simulator's own
+/// stall (its process descheduled on a busy machine): nodes are ticked every millisecond, so
+/// this is fifty ticks missed.
+const STALL: Duration = Duration::from_millis(50);
+
+/// Tells the nodes the time beyond [`STALL`] since `last`, a stall of the simulator, and
+/// returns now.
+fn excuse_stall(nodes: &[SharedNode], last: Instant) -> Instant {
+    let now = Instant::now();
+    let gap = now.saturating_duration_since(last);
+    if gap > STALL {
+        for node in nodes {
+            lock(node).node.excuse(gap - STALL);
+        }
+    }
+    now
+}
+
 /// A node shared by its runner and [`SimulatedForm::state`](super::SimulatedForm::state).
 pub(crate) type SharedNode = Arc<Mutex<NodeSim>>;
 
@@ -26,12 +44,21 @@ pub(crate) async fn node_on_can(node: SharedNode, port: CanPort, tick: Duration,
     ticker.set_missed_tick_behavior(MissedTickBehavior::Delay);
     // Answers held back by a `slow` fault, in sending order.
     let mut delayed: Vec<(Instant, Packet)> = Vec::new();
+    let mut awake = Instant::now();
     loop {
         let next_delayed = delayed.first().map(|(at, _)| *at);
-        tokio::select! {
+        let woken = tokio::select! {
             biased;
-            frame = receiver.recv() => {
-                let Some(frame) = frame else { return };
+            frame = receiver.recv() => Woken::Frame(frame),
+            () = sleep_until(next_delayed.unwrap_or(start)), if next_delayed.is_some() => {
+                Woken::Delayed
+            }
+            _ = ticker.tick() => Woken::Tick,
+        };
+        awake = excuse_stall(std::slice::from_ref(&node), awake);
+        match woken {
+            Woken::Frame(None) => return,
+            Woken::Frame(Some(frame)) => {
                 // Frames that are not this protocol's are not for the node.
                 let Ok(packet) = can::decode(&frame) else { continue };
                 let now = Instant::now();
@@ -44,18 +71,25 @@ pub(crate) async fn node_on_can(node: SharedNode, port: CanPort, tick: Duration,
                     delayed.splice(index..index, answer.into_iter().map(|p| (at, p)));
                 }
             }
-            () = sleep_until(next_delayed.unwrap_or(start)), if next_delayed.is_some() => {
+            Woken::Delayed => {
                 let now = Instant::now();
                 let due = delayed.partition_point(|(t, _)| *t <= now);
                 let packets: Vec<Packet> = delayed.drain(..due).map(|(_, p)| p).collect();
                 send(&sender, &packets);
             }
-            _ = ticker.tick() => {
+            Woken::Tick => {
                 let packets = lock(&node).tick(Instant::now());
                 send(&sender, &packets);
             }
         }
     }
+}
+
+/// What woke a node's runner.
+enum Woken {
+    Frame(Option<firmware_protocol::can::Frame>),
+    Delayed,
+    Tick,
 }
 
 fn send(sender: &CanSender, packets: &[Packet]) {
@@ -76,8 +110,11 @@ pub(crate) async fn nodes_on_serial(
     tick: Duration,
 ) -> io::Result<()> {
     let mut next_tick = Instant::now();
+    let mut awake = Instant::now();
     loop {
-        match line.next_request(next_tick).await? {
+        let request = line.next_request(next_tick).await?;
+        awake = excuse_stall(nodes, awake);
+        match request {
             Some(request) => {
                 let now = Instant::now();
                 for node in nodes {

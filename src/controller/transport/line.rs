@@ -1,7 +1,8 @@
 //! A serial device shared by the serial and slcan links: `serialport` opens it (a USB
 //! adapter or a pseudo-terminal alike); a reader thread turns the bytes into packets with the
 //! link's parser and hands them to tokio through a channel; writes are small (at most a
-//! frame) and go straight to the port.
+//! frame) and go straight to the port through a second handle, which the link's
+//! [`Gate`](super::super::estop::Gate) owns (so an e-stop never waits for the reader).
 
 use std::io::{ErrorKind, Read, Write};
 use std::path::Path;
@@ -15,13 +16,13 @@ use tokio::sync::mpsc;
 
 use super::TransportError;
 
-/// How long a read waits before the reader checks whether it should stop.
+/// How long a read waits before the reader checks whether it should stop; also the longest a
+/// write waits for a device that does not take its bytes.
 const READ_TIMEOUT: Duration = Duration::from_millis(10);
 
-/// An open serial device with its reader thread.
+/// The reading side of an open serial device: its reader thread.
 pub struct Line {
     device: String,
-    writer: Box<dyn SerialPort>,
     packets: mpsc::UnboundedReceiver<Result<Packet, String>>,
     stop: Arc<AtomicBool>,
     reader: Option<std::thread::JoinHandle<()>>,
@@ -35,12 +36,12 @@ impl std::fmt::Debug for Line {
 
 impl Line {
     /// Opens `path` at `baud` (8N1) and starts reading with `parse`, which turns each chunk
-    /// of bytes into the packets it completes.
+    /// of bytes into the packets it completes; returns the reader and the port to write to.
     pub fn open(
         path: &Path,
         baud: u32,
         mut parse: impl FnMut(&[u8], &mut Vec<Packet>) + Send + 'static,
-    ) -> Result<Self, TransportError> {
+    ) -> Result<(Self, Writer), TransportError> {
         let device = path.display().to_string();
         let io = |source| TransportError::Io { device: device.clone(), source };
         let writer = serialport::new(device.clone(), baud)
@@ -82,20 +83,13 @@ impl Line {
                 }
             })
             .map_err(io)?;
-        Ok(Self { device, writer, packets, stop, reader: Some(reader) })
+        let line = Self { device: device.clone(), packets, stop, reader: Some(reader) };
+        Ok((line, Writer { device, port: writer }))
     }
 
     /// The device path.
     pub fn device(&self) -> String {
         self.device.clone()
-    }
-
-    /// Writes `bytes` in full.
-    pub fn write(&mut self, bytes: &[u8]) -> Result<(), TransportError> {
-        self.writer
-            .write_all(bytes)
-            .and_then(|()| self.writer.flush())
-            .map_err(|source| TransportError::Io { device: self.device.clone(), source })
     }
 
     /// The next packet the reader parsed.
@@ -108,6 +102,27 @@ impl Line {
             }),
             None => Err(TransportError::Closed(self.device.clone())),
         }
+    }
+}
+
+/// The writing handle of an open serial device.
+pub struct Writer {
+    device: String,
+    port: Box<dyn SerialPort>,
+}
+
+impl Writer {
+    /// Writes `bytes` in full (each write waits at most [`READ_TIMEOUT`] for the device).
+    pub fn write(&mut self, bytes: &[u8]) -> Result<(), TransportError> {
+        self.port
+            .write_all(bytes)
+            .and_then(|()| self.port.flush())
+            .map_err(|source| TransportError::Io { device: self.device.clone(), source })
+    }
+
+    /// The device path.
+    pub fn device(&self) -> &str {
+        &self.device
     }
 }
 

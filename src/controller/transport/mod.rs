@@ -8,6 +8,8 @@
 //! | slcan (Lawicel USB-CAN adapter) on a serial port | [`slcan::Slcan`] | `tIIILDD..\r` text, classic CAN only | cyclically (CAN) |
 //! | SocketCAN interface | [`socketcan::SocketCan`] | kernel CAN frames, classic CAN | cyclically (CAN) |
 //!
+//! Every link sends through its [`Gate`]: the e-stop path (see [`crate::controller::estop`]).
+//!
 //! Packet handling: a received frame that does not decode (bad CRC, unknown code, invalid
 //! field, an extended or remote CAN frame) is dropped and counted, never an error; only the
 //! link itself failing is. Packets the link cannot carry (a 16-byte `AllTargets` on classic
@@ -25,6 +27,8 @@ use std::future::Future;
 use std::path::PathBuf;
 
 use firmware_protocol::{Link, Packet};
+
+use super::estop::{Gate, StopCause};
 
 /// Why a link failed.
 #[derive(Debug, thiserror::Error)]
@@ -48,6 +52,14 @@ pub enum TransportError {
         /// The packet.
         what: String,
     },
+    /// The link was e-stopped: only emergency stops go out any more.
+    #[error("{device}: stopped by {cause}")]
+    Stopped {
+        /// The device.
+        device: String,
+        /// Who stopped it.
+        cause: StopCause,
+    },
 }
 
 /// A link to the form's nodes.
@@ -59,8 +71,14 @@ pub trait Transport: Send {
     /// A name for messages (`/dev/ttyUSB0`, `can0`, `simulated bus`).
     fn device(&self) -> String;
 
-    /// Sends one packet (returns once it is handed to the link).
-    fn send(&mut self, packet: Packet) -> impl Future<Output = Result<(), TransportError>> + Send;
+    /// The link's sending half, shared with the e-stop.
+    fn gate(&self) -> &Gate;
+
+    /// Sends one packet through the gate (returns once it is handed to the link).
+    fn send(&mut self, packet: Packet) -> impl Future<Output = Result<(), TransportError>> + Send {
+        let sent = self.gate().send(&packet);
+        async move { sent }
+    }
 
     /// The next packet received. Cancel-safe: dropping the future loses nothing.
     fn recv(&mut self) -> impl Future<Output = Result<Packet, TransportError>> + Send;
@@ -127,12 +145,12 @@ impl Transport for Connection {
         }
     }
 
-    async fn send(&mut self, packet: Packet) -> Result<(), TransportError> {
+    fn gate(&self) -> &Gate {
         match self {
-            Self::Serial(t) => t.send(packet).await,
-            Self::Slcan(t) => t.send(packet).await,
-            Self::Can(t) => t.send(packet).await,
-            Self::Sim(t) => t.send(packet).await,
+            Self::Serial(t) => t.gate(),
+            Self::Slcan(t) => t.gate(),
+            Self::Can(t) => t.gate(),
+            Self::Sim(t) => t.gate(),
         }
     }
 

@@ -11,8 +11,9 @@ use std::path::Path;
 
 use firmware_protocol::{Link, Packet, serial};
 
-use super::line::Line;
+use super::line::{Line, Writer};
 use super::{Transport, TransportError};
+use crate::controller::estop::{Gate, PacketSink};
 
 /// The line speed of the serial mapping.
 pub const BAUD: u32 = 1_000_000;
@@ -21,19 +22,43 @@ pub const BAUD: u32 = 1_000_000;
 #[derive(Debug)]
 pub struct SerialLine {
     line: Line,
+    gate: Gate,
+}
+
+/// The writing side: numbers the frames (a retry keeps its number, as the protocol asks).
+struct Numbered {
+    writer: Writer,
     seq: u8,
     last: Option<Packet>,
+}
+
+impl PacketSink for Numbered {
+    fn write(&mut self, packet: &Packet) -> Result<(), TransportError> {
+        if self.last != Some(*packet) {
+            self.seq = self.seq.wrapping_add(1);
+            self.last = Some(*packet);
+        }
+        let wire =
+            serial::encode(&serial::Frame { seq: self.seq, packet: *packet }).map_err(|e| {
+                TransportError::Unsupported {
+                    device: self.writer.device().to_string(),
+                    what: format!("{}: {e}", packet.message.code().name()),
+                }
+            })?;
+        self.writer.write(&wire)
+    }
 }
 
 impl SerialLine {
     /// Opens the port and flushes the nodes' partial frame with a lone `0x00`.
     pub fn open(path: &Path) -> Result<Self, TransportError> {
         let mut decoder = serial::Decoder::new();
-        let mut line = Line::open(path, BAUD, move |bytes, out| {
+        let (line, mut writer) = Line::open(path, BAUD, move |bytes, out| {
             out.extend(decoder.feed(bytes).filter_map(Result::ok).map(|frame| frame.packet));
         })?;
-        line.write(&[0])?;
-        Ok(Self { line, seq: 0, last: None })
+        writer.write(&[0])?;
+        let gate = Gate::new(line.device(), Numbered { writer, seq: 0, last: None });
+        Ok(Self { line, gate })
     }
 }
 
@@ -46,15 +71,8 @@ impl Transport for SerialLine {
         self.line.device()
     }
 
-    async fn send(&mut self, packet: Packet) -> Result<(), TransportError> {
-        if self.last != Some(packet) {
-            self.seq = self.seq.wrapping_add(1);
-            self.last = Some(packet);
-        }
-        let wire = serial::encode(&serial::Frame { seq: self.seq, packet }).map_err(|e| {
-            TransportError::Unsupported { device: self.device(), what: format!("{packet:?}: {e}") }
-        })?;
-        self.line.write(&wire)
+    fn gate(&self) -> &Gate {
+        &self.gate
     }
 
     async fn recv(&mut self) -> Result<Packet, TransportError> {

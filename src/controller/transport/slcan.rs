@@ -15,23 +15,43 @@ use std::path::Path;
 
 use firmware_protocol::{Link, Packet, can};
 
-use super::line::Line;
+use super::line::{Line, Writer};
 use super::{Transport, TransportError};
+use crate::controller::estop::{Gate, PacketSink};
 
 /// The longest line kept while parsing (a frame line is at most 26 characters).
 const MAX_LINE: usize = 64;
+
+/// The adapter's serial speed (ignored by USB adapters and ptys; the usual setting).
+const BAUD: u32 = 115_200;
 
 /// An slcan adapter.
 #[derive(Debug)]
 pub struct Slcan {
     line: Line,
+    gate: Gate,
+}
+
+/// The writing side: one text line per frame.
+struct Lines(Writer);
+
+impl PacketSink for Lines {
+    fn write(&mut self, packet: &Packet) -> Result<(), TransportError> {
+        let unsupported = |what: &str| TransportError::Unsupported {
+            device: self.0.device().to_string(),
+            what: format!("{} ({what})", packet.message.code().name()),
+        };
+        let frame = can::encode(packet).map_err(|e| unsupported(&e.to_string()))?;
+        let text = format_frame(&frame).ok_or_else(|| unsupported("not a classic CAN frame"))?;
+        self.0.write(text.as_bytes())
+    }
 }
 
 impl Slcan {
     /// Opens the adapter's port and its channel at 1 Mbit/s.
     pub fn open(path: &Path) -> Result<Self, TransportError> {
         let mut text = Vec::new();
-        let mut line = Line::open(path, 115_200, move |bytes, out| {
+        let (line, mut writer) = Line::open(path, BAUD, move |bytes, out| {
             for &byte in bytes {
                 match byte {
                     b'\r' | b'\x07' => {
@@ -44,8 +64,9 @@ impl Slcan {
                 }
             }
         })?;
-        line.write(b"C\rS8\rO\r")?;
-        Ok(Self { line })
+        writer.write(b"C\rS8\rO\r")?;
+        let gate = Gate::new(line.device(), Lines(writer));
+        Ok(Self { line, gate })
     }
 }
 
@@ -93,13 +114,8 @@ impl Transport for Slcan {
         self.line.device()
     }
 
-    async fn send(&mut self, packet: Packet) -> Result<(), TransportError> {
-        let unsupported =
-            |what: String| TransportError::Unsupported { device: self.device(), what };
-        let frame = can::encode(&packet).map_err(|e| unsupported(format!("{packet:?}: {e}")))?;
-        let text = format_frame(&frame)
-            .ok_or_else(|| unsupported(format!("{packet:?} (not a classic CAN frame)")))?;
-        self.line.write(text.as_bytes())
+    fn gate(&self) -> &Gate {
+        &self.gate
     }
 
     async fn recv(&mut self) -> Result<Packet, TransportError> {

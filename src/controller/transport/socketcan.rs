@@ -5,17 +5,46 @@
 //! frame by [`to_socketcan`]; received frames decode straight from `socketcan::CanFrame`
 //! (an `embedded_can::Frame`); extended, remote and error frames are dropped. CAN FD
 //! interfaces are not supported yet: the link is classic (`Targets` halves).
+//!
+//! Frames go out through a blocking socket of their own (with a write timeout), which the
+//! link's [`Gate`] owns, so an e-stop never waits for the runtime; frames come in through the
+//! tokio socket.
+
+use std::time::Duration;
 
 use embedded_can::Frame as _;
 use firmware_protocol::{Link, Packet, can};
-use socketcan::{CanFrame, tokio::CanSocket};
+use socketcan::{CanFrame, Socket as _, tokio::CanSocket};
 
 use super::{Transport, TransportError};
+use crate::controller::estop::{Gate, PacketSink};
+
+/// The longest a frame write waits for room in the interface's queue.
+const WRITE_TIMEOUT: Duration = Duration::from_millis(10);
 
 /// An open SocketCAN interface.
 pub struct SocketCan {
     interface: String,
     socket: CanSocket,
+    gate: Gate,
+}
+
+/// The sending socket.
+struct Writer {
+    interface: String,
+    socket: socketcan::CanSocket,
+}
+
+impl PacketSink for Writer {
+    fn write(&mut self, packet: &Packet) -> Result<(), TransportError> {
+        let frame = to_socketcan(packet).ok_or_else(|| TransportError::Unsupported {
+            device: self.interface.clone(),
+            what: format!("{} (not a classic CAN frame)", packet.message.code().name()),
+        })?;
+        self.socket
+            .write_frame(&frame)
+            .map_err(|source| TransportError::Io { device: self.interface.clone(), source })
+    }
 }
 
 impl std::fmt::Debug for SocketCan {
@@ -27,9 +56,13 @@ impl std::fmt::Debug for SocketCan {
 impl SocketCan {
     /// Opens `interface`. Fails where the kernel has no SocketCAN (`socket(AF_CAN)` fails).
     pub fn open(interface: &str) -> Result<Self, TransportError> {
-        let socket = CanSocket::open(interface)
-            .map_err(|source| TransportError::Io { device: interface.to_string(), source })?;
-        Ok(Self { interface: interface.to_string(), socket })
+        let io = |source| TransportError::Io { device: interface.to_string(), source };
+        let socket = CanSocket::open(interface).map_err(io)?;
+        let writer = socketcan::CanSocket::open(interface).map_err(io)?;
+        writer.set_write_timeout(WRITE_TIMEOUT).map_err(io)?;
+        let gate =
+            Gate::new(interface, Writer { interface: interface.to_string(), socket: writer });
+        Ok(Self { interface: interface.to_string(), socket, gate })
     }
 }
 
@@ -56,15 +89,8 @@ impl Transport for SocketCan {
         self.interface.clone()
     }
 
-    async fn send(&mut self, packet: Packet) -> Result<(), TransportError> {
-        let frame = to_socketcan(&packet).ok_or_else(|| TransportError::Unsupported {
-            device: self.device(),
-            what: format!("{packet:?} (not a classic CAN frame)"),
-        })?;
-        self.socket
-            .write_frame(frame)
-            .await
-            .map_err(|source| TransportError::Io { device: self.device(), source })
+    fn gate(&self) -> &Gate {
+        &self.gate
     }
 
     async fn recv(&mut self) -> Result<Packet, TransportError> {

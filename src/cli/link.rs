@@ -1,0 +1,117 @@
+//! Where the form is (`--sim`, `--serial`, `--slcan`, `--can`), which form it is (`--form`,
+//! the built-in reference form by default), and owning its link for one command: the control
+//! endpoint that lets `dressform estop` reach this process, and the signals that e-stop it.
+
+use std::path::PathBuf;
+
+use dressform::controller::control::Endpoint;
+use dressform::controller::simulated::{SimConfig, SimDriveError, SimulatedRig};
+use dressform::controller::{Connection, LinkSpec, Transport};
+use sim::form::FormDescription;
+
+use super::Failure;
+use super::signals::{self, Armed};
+
+/// Where the form is.
+#[derive(Debug, Clone, clap::Args)]
+#[group(required = true, multiple = false)]
+pub struct LinkArgs {
+    /// The in-process simulated form (no hardware needed; it lives as long as the command).
+    #[arg(long)]
+    sim: bool,
+    /// A serial port speaking the protocol's serial mapping (1 Mbaud).
+    #[arg(long, value_name = "PATH")]
+    serial: Option<PathBuf>,
+    /// An slcan (Lawicel) USB-CAN adapter on a serial port (classic CAN, 1 Mbit/s).
+    #[arg(long, value_name = "PATH")]
+    slcan: Option<PathBuf>,
+    /// A SocketCAN interface (can0, vcan0...).
+    #[arg(long, value_name = "IFACE")]
+    can: Option<String>,
+}
+
+impl LinkArgs {
+    pub fn spec(&self) -> LinkSpec {
+        match (&self.serial, &self.slcan, &self.can) {
+            (Some(path), _, _) => LinkSpec::Serial(path.clone()),
+            (_, Some(path), _) => LinkSpec::Slcan(path.clone()),
+            (_, _, Some(iface)) => LinkSpec::Can(iface.clone()),
+            _ => LinkSpec::Sim,
+        }
+    }
+}
+
+/// `--form`, shared by every command that needs a form.
+#[derive(Debug, Clone, clap::Args)]
+pub struct FormArg {
+    /// The form description (TOML) [default: the built-in reference form; see
+    /// `dressform form show --toml`].
+    #[arg(long, value_name = "FORM.toml")]
+    form: Option<PathBuf>,
+}
+
+impl FormArg {
+    /// Loads `--form`, or the built-in reference form.
+    pub fn load(&self) -> Result<FormDescription, Failure> {
+        match &self.form {
+            Some(path) => FormDescription::load(path).map_err(Failure::bad_input),
+            None => Ok(sim::form::reference()),
+        }
+    }
+
+    /// The file given, if any.
+    pub fn path(&self) -> Option<&PathBuf> {
+        self.form.as_ref()
+    }
+}
+
+/// A current-thread runtime for one command.
+pub fn runtime() -> Result<tokio::runtime::Runtime, Failure> {
+    tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .map_err(|e| Failure::other(format!("cannot start the runtime: {e}")))
+}
+
+/// A hardware link owned by this process: e-stops from another terminal and from signals
+/// reach it until it is dropped.
+pub struct Owned {
+    pub connection: Connection,
+    _armed: Armed,
+    // Dropped after the connection's session: the endpoint answers to the end.
+    _endpoint: Option<Endpoint>,
+}
+
+/// Opens a hardware link and owns it: binds its control endpoint first (refusing a link
+/// another dressform process owns, before anything is written to the device), then opens it
+/// and arms the endpoint and the signals with its gate.
+pub fn own(spec: &LinkSpec) -> Result<Owned, Failure> {
+    let endpoint = Endpoint::bind(spec).map_err(Failure::other)?;
+    let connection = Connection::open(spec).map_err(Failure::other)?;
+    if let Some(endpoint) = &endpoint {
+        endpoint.arm(connection.gate()).map_err(Failure::other)?;
+    }
+    let armed = signals::arm(connection.gate());
+    Ok(Owned { connection, _armed: armed, _endpoint: endpoint })
+}
+
+/// Starts the in-process simulated form; its link, once attached, is armed for signals by
+/// [`arm`].
+pub fn simulated(form: &FormDescription, config: &SimConfig) -> Result<SimulatedRig, Failure> {
+    SimulatedRig::start(form, config).map_err(sim_failure)
+}
+
+/// Arms a link this process made (the simulated form's) for signals.
+pub fn arm<T: Transport>(transport: &T) -> Armed {
+    signals::arm(transport.gate())
+}
+
+/// How a simulated form's failure ends the command: its description or faults are bad
+/// input (2), its log failed (1), the drive failed as drives do.
+pub fn sim_failure(e: SimDriveError) -> Failure {
+    match e {
+        SimDriveError::Sim(_) => Failure::bad_input(e),
+        SimDriveError::Log { .. } => Failure::other(e),
+        SimDriveError::Drive(d) => d.into(),
+    }
+}

@@ -1,0 +1,196 @@
+//! A tailor's measurement set, named as in ISO 8559-1, taken on a segmented body (its mesh,
+//! [`BodyRegions`] and measurement [`Levels`]): values in, values out, no stage re-deriving
+//! the regions. Each rule is stated on its field and in the README, so that a tailor can
+//! check it with a tape; lengths in millimetres, angles in degrees, heights above the floor.
+
+use super::Levels;
+use crate::mesh::Mesh;
+use crate::regions::{BodyRegions, Region};
+use crate::slice::Contour;
+use glam::{DVec2, DVec3};
+use serde::Serialize;
+
+/// A measurement taken on both sides of the body.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Bilateral {
+    /// On the subject's left (+X).
+    pub left: f64,
+    /// On the subject's right.
+    pub right: f64,
+    /// Left minus right.
+    pub difference: f64,
+}
+
+impl Bilateral {
+    fn new(left: f64, right: f64) -> Bilateral {
+        Bilateral { left, right, difference: left - right }
+    }
+}
+
+/// The body dimensions of ISO 8559-1 that a scan shows (see each field for its rule).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BodyDimensions {
+    /// Stature: floor to the top of the head.
+    pub stature_mm: f64,
+    /// Neck girth: the tape girth of the neck at its narrowest level between the shoulders
+    /// and the head (horizontal).
+    pub neck_girth_mm: f64,
+    /// Shoulder width (biacromial breadth): the horizontal distance between the two shoulder
+    /// points (acromions), found as the armholes' shoulder points.
+    pub shoulder_width_mm: f64,
+    /// Shoulder slope: the angle below horizontal of the line from the side of the neck (the
+    /// neck section's outermost point at the neck level) to the shoulder point.
+    pub shoulder_slope_deg: Bilateral,
+    /// Chest (bust) girth: the largest horizontal tape girth just below the lower armpit.
+    pub chest_girth_mm: f64,
+    /// Underbust girth: the horizontal tape girth where the front is set farthest back
+    /// between the chest level and 10% of the stature below it (the fold under the breasts).
+    pub underbust_girth_mm: f64,
+    /// Waist girth: the horizontal tape girth at the waist level.
+    pub waist_girth_mm: f64,
+    /// Waist height: floor to the waist level.
+    pub waist_height_mm: f64,
+    /// High hip girth: the horizontal tape girth midway between the waist and hip levels.
+    pub high_hip_girth_mm: f64,
+    /// Hip girth: the horizontal tape girth at the hip level (the buttocks' greatest
+    /// protrusion).
+    pub hip_girth_mm: f64,
+    /// Hip height: floor to the hip level.
+    pub hip_height_mm: f64,
+    /// Thigh girth: horizontal tape girth of each leg just below the buttocks, at
+    /// [`THIGH_BELOW_CROTCH`] of the stature below the crotch.
+    pub thigh_girth_mm: Bilateral,
+    /// Knee girth: horizontal tape girth of each leg at the knee, taken at
+    /// [`KNEE_OF_CROTCH`] of the crotch height.
+    pub knee_girth_mm: Bilateral,
+    /// Calf girth: the largest horizontal tape girth of each leg between the knee and the
+    /// ankle.
+    pub calf_girth_mm: Bilateral,
+    /// Ankle girth: the smallest horizontal tape girth of each leg above the foot (at the
+    /// ankle landmark, the legs' narrowest level between 3% and 15% of the stature).
+    pub ankle_girth_mm: Bilateral,
+    /// Inside leg length: floor to the crotch (where the legs part).
+    pub inside_leg_mm: f64,
+    /// Back waist length: from the back of the neck at the neck level down the back's
+    /// midline, over its curve, to the waist level.
+    pub back_waist_length_mm: f64,
+    /// Front waist length: from the front of the neck at the neck level down the front's
+    /// midline, over the chest, to the waist level.
+    pub front_waist_length_mm: f64,
+}
+
+/// How far below the crotch the thigh girth is taken, as a fraction of the stature: 2%,
+/// about 3.5 cm on an adult, just under the gluteal fold where the thigh is round.
+pub const THIGH_BELOW_CROTCH: f64 = 0.02;
+/// The knee's height as a fraction of the crotch height: the knee joint lies at 0.285 of the
+/// stature and the crotch at 0.47 (Drillis and Contini's segment proportions): 0.6.
+pub const KNEE_OF_CROTCH: f64 = 0.6;
+/// How far below the chest the underbust is looked for, as a fraction of the stature.
+const UNDERBUST_SPAN: f64 = 0.10;
+/// Spacing of the levels searched and of the midline profiles (mm).
+const STEP_MM: f64 = 2.0;
+/// Half-width of the band around the midline whose front- or backmost point a waist length
+/// follows (mm).
+const MIDLINE_BAND_MM: f64 = 15.0;
+
+/// `count` heights from `lo` to `hi` inclusive.
+fn heights(lo: f64, hi: f64) -> Vec<f64> {
+    let count = (((hi - lo).abs() / STEP_MM) as usize).max(1) + 1;
+    (0..count).map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64).collect()
+}
+
+fn tape(c: &Option<Contour>) -> f64 {
+    c.as_ref().map_or(0.0, Contour::tape_girth)
+}
+
+/// The length of the torso's midline profile from `from` up to `to`: the front-most
+/// (`front`) or back-most point near the centre line at each level, joined.
+fn midline_length(body: &Mesh, regions: &BodyRegions, from: f64, to: f64, front: bool) -> f64 {
+    let zs = heights(from, to);
+    let cx = regions.landmarks.centre_x;
+    let profile: Vec<DVec2> = zs
+        .iter()
+        .zip(regions.torso_sections(body, &zs))
+        .filter_map(|(&z, c)| {
+            let ys = c?.points.into_iter().filter(|p| (p.x - cx).abs() <= MIDLINE_BAND_MM);
+            let y = if front {
+                ys.map(|p| p.y).fold(None, |m: Option<f64>, y| Some(m.map_or(y, |m| m.min(y))))
+            } else {
+                ys.map(|p| p.y).fold(None, |m: Option<f64>, y| Some(m.map_or(y, |m| m.max(y))))
+            }?;
+            Some(DVec2::new(y, z))
+        })
+        .collect();
+    profile.windows(2).map(|w| w[0].distance(w[1])).sum()
+}
+
+/// The tape girth of the left and right leg at each of `zs`: per height (left, right).
+fn leg_girths(body: &Mesh, regions: &BodyRegions, zs: &[f64]) -> Vec<(f64, f64)> {
+    let left = regions.sections_of(body, Region::LeftLeg, zs);
+    let right = regions.sections_of(body, Region::RightLeg, zs);
+    left.iter().zip(&right).map(|(l, r)| (tape(l), tape(r))).collect()
+}
+
+/// The body dimensions of `body`, segmented as `regions`, with its measurement `levels`.
+pub fn dimensions(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> BodyDimensions {
+    let m = &regions.landmarks;
+    let h = m.height;
+    let torso = |zs: &[f64]| regions.torso_sections(body, zs);
+
+    // Underbust: the level below the chest where the front is set farthest back.
+    let under = heights(levels.chest - UNDERBUST_SPAN * h, levels.chest);
+    let under_loops = torso(&under);
+    let front = |c: &Contour| c.points.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+    let underbust = under_loops
+        .iter()
+        .filter_map(|c| c.as_ref().map(|c| (front(c), c.tape_girth())))
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map_or(0.0, |(_, g)| g);
+
+    let main =
+        torso(&[levels.chest, levels.waist, 0.5 * (levels.waist + levels.hip), levels.hip, m.neck]);
+    // Shoulder slope from the side of the neck at the neck level to each shoulder point.
+    let neck_loop = main[4].clone().unwrap_or_default();
+    let neck_side = |sign: f64| {
+        neck_loop
+            .points
+            .iter()
+            .copied()
+            .max_by(|a, b| (sign * a.x).total_cmp(&(sign * b.x)))
+            .unwrap_or(DVec2::new(m.centre_x, 0.0))
+            .extend(m.neck)
+    };
+    let slope = |point: DVec3, side: DVec3| {
+        let run = (point.truncate() - side.truncate()).length().max(f64::EPSILON);
+        ((side.z - point.z) / run).atan().to_degrees()
+    };
+    let (ls, rs) = (m.left_armhole.shoulder_point, m.right_armhole.shoulder_point);
+
+    // Legs: thigh, knee, ankle at their levels; the calf the largest between knee and ankle.
+    let knee_z = KNEE_OF_CROTCH * m.crotch;
+    let fixed = leg_girths(body, regions, &[m.crotch - THIGH_BELOW_CROTCH * h, knee_z, m.ankle]);
+    let calf = leg_girths(body, regions, &heights(m.ankle, knee_z));
+    let largest = |pick: fn(&(f64, f64)) -> f64| calf.iter().map(pick).fold(0.0, f64::max);
+    let bilateral = |(l, r): (f64, f64)| Bilateral::new(l, r);
+
+    BodyDimensions {
+        stature_mm: h,
+        neck_girth_mm: neck_loop.tape_girth(),
+        shoulder_width_mm: (ls.x - rs.x).abs(),
+        shoulder_slope_deg: Bilateral::new(slope(ls, neck_side(1.0)), slope(rs, neck_side(-1.0))),
+        chest_girth_mm: tape(&main[0]),
+        underbust_girth_mm: underbust,
+        waist_girth_mm: tape(&main[1]),
+        waist_height_mm: levels.waist,
+        high_hip_girth_mm: tape(&main[2]),
+        hip_girth_mm: tape(&main[3]),
+        hip_height_mm: levels.hip,
+        thigh_girth_mm: bilateral(fixed[0]),
+        knee_girth_mm: bilateral(fixed[1]),
+        calf_girth_mm: Bilateral::new(largest(|g| g.0), largest(|g| g.1)),
+        ankle_girth_mm: bilateral(fixed[2]),
+        inside_leg_mm: m.crotch,
+        back_waist_length_mm: midline_length(body, regions, levels.waist, m.neck, false),
+        front_waist_length_mm: midline_length(body, regions, levels.waist, m.neck, true),
+    }
+}

