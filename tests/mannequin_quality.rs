@@ -8,7 +8,7 @@
 use crate::common;
 
 use common::quality::{near_horizontal_area, self_intersecting_pairs, silhouette_top, width_jump};
-use common::{largest_mirror_gap, makehuman};
+use common::{largest_mirror_gap, makehuman, surface_mesh as mesh_of};
 use dressform::mannequin::MannequinOptions;
 use dressform::mesh::{Mesh, smooth::DEFAULT_PASSES};
 use dressform::pipeline::{Symmetrized, symmetrize};
@@ -32,13 +32,6 @@ struct Case {
 fn acromions(body: &SyntheticBody, scan: &Scan) -> Option<[DVec3; 2]> {
     let sides = [&body.truth.landmarks.left, &body.truth.landmarks.right];
     Some(sides.map(|s| scan.frame.to_canonical(DVec3::from_array(s.acromion))))
-}
-
-fn mesh_of(surface: &sim::capture::TriangleSurface) -> Mesh {
-    Mesh::new(
-        surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
-        surface.triangles.clone(),
-    )
 }
 
 fn generated(name: String, params: &BodyParams) -> Case {

@@ -4,9 +4,7 @@
 
 use crate::common;
 
-use dressform::mesh::Mesh;
 use dressform::scan::format::Format;
-use glam::DVec3;
 use sim::capture::{BodyParams, generate};
 
 /// The level lines' colours in the preview (chest, waist, hip), as documented in
@@ -17,10 +15,7 @@ const NEAR: i32 = 40;
 /// Runs `symmetrize` on the default synthetic customer; returns the output directory.
 fn symmetrized() -> tempfile::TempDir {
     let body = generate(&BodyParams::default()).unwrap();
-    let mesh = Mesh::new(
-        body.surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
-        body.surface.triangles.clone(),
-    );
+    let mesh = common::mesh_of(&body);
     let dir = tempfile::tempdir().unwrap();
     let scan = dir.path().join("customer.ply");
     std::fs::write(&scan, Format::Ply.encode(&mesh)).unwrap();
@@ -40,8 +35,9 @@ fn the_preview_draws_the_levels_at_their_heights_on_all_six_bodies() {
     let measurements: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("measurements.json")).unwrap())
             .unwrap();
-    let z: Vec<f64> =
-        ["chest", "waist", "hip"].map(|k| measurements["levels"][k].as_f64().unwrap()).to_vec();
+    let z: Vec<f64> = ["chest", "waist", "hip"]
+        .map(|k| measurements["levels"][format!("{k}_mm")].as_f64().unwrap())
+        .to_vec();
     let png = image::load_from_memory(&std::fs::read(dir.path().join("preview.png")).unwrap())
         .unwrap()
         .to_rgb8();
@@ -82,10 +78,10 @@ fn the_sections_figure_gives_the_girths_of_the_measurements() {
     assert_eq!(svg.matches("<path").count(), 12, "four curves at each of three levels");
     for row in measurements["table"].as_array().unwrap() {
         let name = row["measure"].as_str().unwrap();
-        let z = row["z"].as_f64().unwrap();
+        let z = row["z_mm"].as_f64().unwrap();
         assert!(svg.contains(&format!("{name} (z = {z:.0} mm)")), "{name}");
         for (body, girth) in [("scan", &row["input"]), ("mannequin", &row["mannequin"])] {
-            let text = format!("{body}: tape girth {:.1} mm", girth["tape"].as_f64().unwrap());
+            let text = format!("{body}: tape girth {:.1} mm", girth["tape_mm"].as_f64().unwrap());
             assert!(svg.contains(&text), "{text}");
         }
     }
@@ -93,7 +89,10 @@ fn the_sections_figure_gives_the_girths_of_the_measurements() {
     {
         let body = row["body"].as_str().unwrap();
         for level in ["chest", "waist", "hip"] {
-            let text = format!("{body}: tape girth {:.1} mm", row[level].as_f64().unwrap());
+            let text = format!(
+                "{body}: tape girth {:.1} mm",
+                row[format!("{level}_mm")].as_f64().unwrap()
+            );
             assert!(svg.contains(&text), "Fig. 11 row {k}: {text}");
         }
     }

@@ -10,8 +10,9 @@
 //! Where they differ by more, the layers' widths are eased by about the least largest change
 //! that meets the limit: the layers below the ledge narrow and those above widen by about as
 //! much (the mean of the narrowest and the widest width sequences within the limit), while
-//! the widest layer and the neck keep their widths, so the neck is never widened into a box:
-//! from a short neck the shoulders slope down at the limit. An eased
+//! the widest layer and the neck keep their widths, so the neck is not widened into a box:
+//! from a short neck the shoulders slope down at the limit (a neck too short even for that is
+//! widened as little as the limit allows). An eased
 //! layer takes the shape the layers have a little higher up (to narrow) or lower down (to
 //! widen) where that shape is just as wide: the layers are read as one surface, each ray
 //! running straight from one layer to the next, as the rebuilt mesh joins them. So the
@@ -38,10 +39,10 @@ fn width(points: &[DVec2], axis: f64) -> f64 {
 }
 
 /// The widths changing by at most `limit` per mm closest to `w` (at heights `z`, ascending),
-/// the first (the widest layer) and the last (the neck) kept: the mean of the smallest
+/// the first (the widest layer) and, where it can be, the last (the neck) kept: the mean of the smallest
 /// sequence within the limit above `w` and the largest below it (the closest such sequence
-/// in the largest difference), clamped to the band the two kept ends leave (so the neck is
-/// never widened into a box and the shoulders slope down from it).
+/// in the largest difference), clamped to the band the kept ends leave (so the neck is not
+/// widened into a box and the shoulders slope down from it).
 fn eased_widths(z: &[f64], w: &[f64], limit: f64) -> Vec<f64> {
     let n = w.len();
     let reach = |k: usize| limit * (z[k] - z[k - 1]);
@@ -56,12 +57,17 @@ fn eased_widths(z: &[f64], w: &[f64], limit: f64) -> Vec<f64> {
     }
     let (first, last) = (w[0], w[n - 1]);
     let (z0, zn) = (z[0], z[n - 1]);
+    // A neck too short for the shoulders to slope down to it within the limit is widened
+    // (as little as the limit allows) rather than the layer at the shoulder points narrowed.
+    let neck_kept = (first - last).abs() <= limit * (zn - z0);
     (0..n)
         .map(|k| {
             let (below, above) = (limit * (z[k] - z0), limit * (zn - z[k]));
-            let lo = (first - below).max(last - above);
-            let hi = (first + below).min(last + above);
-            (0.5 * (upper[k] + lower[k])).clamp(lo.min(hi), hi)
+            let (mut lo, mut hi) = (first - below, first + below);
+            if neck_kept {
+                (lo, hi) = (lo.max(last - above), hi.min(last + above));
+            }
+            (0.5 * (upper[k] + lower[k])).clamp(lo, hi)
         })
         .collect()
 }
@@ -150,11 +156,13 @@ fn eased(zone: &[Layer], axis: f64, limit: f64) -> Vec<Layer> {
     out
 }
 
-/// Eases the torso layers above the widest one at or above `from_z` (the lower shoulder point) about
-/// the symmetry plane x = `axis` (see the module documentation).
+/// Eases the torso layers above the widest one from the last layer at or below `from_z` (the
+/// lower shoulder point) up, about the symmetry plane x = `axis` (see the module
+/// documentation). The layer just below the shoulder point is a candidate because the ledge
+/// can begin right above it.
 pub(super) fn ease(torso: &mut [Layer], axis: f64, from_z: f64) {
-    let Some(widest) = (0..torso.len())
-        .filter(|&k| torso[k].z >= from_z)
+    let first = torso.iter().rposition(|l| l.z <= from_z).unwrap_or(0);
+    let Some(widest) = (first..torso.len())
         .max_by(|&a, &b| width(&torso[a].points, axis).total_cmp(&width(&torso[b].points, axis)))
     else {
         return;
@@ -239,6 +247,13 @@ mod tests {
         );
         let eased = eased_widths(&z, &[400.0, 395.0, 195.0, 190.0], 7.0);
         assert_eq!((eased[0], eased[3]), (400.0, 190.0));
+        for k in 1..4 {
+            assert!((eased[k - 1] - eased[k]).abs() <= 70.0 + 1e-9, "{eased:?}");
+        }
+        // A neck too short to slope down to: the widest layer stays, the neck widens.
+        let eased = eased_widths(&z, &[400.0, 390.0, 120.0, 100.0], 7.0);
+        assert_eq!(eased[0], 400.0);
+        assert!(eased[3] > 100.0, "{eased:?}");
         for k in 1..4 {
             assert!((eased[k - 1] - eased[k]).abs() <= 70.0 + 1e-9, "{eased:?}");
         }

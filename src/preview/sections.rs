@@ -27,7 +27,8 @@ const STYLES: [(&str, &str, f64, &str); 4] = [
 ];
 
 /// The part of `c` on one side of x = `axis` with its mirror image: the section of the body
-/// made by mirroring that half (two closed paths that meet on the plane).
+/// made by mirroring that half (two closed paths that meet on the plane, where they share a
+/// cut edge that is no part of the outline).
 fn mirrored(c: &Contour, axis: f64, left: bool) -> [Contour; 2] {
     let half = if left { c.clip_x(axis, f64::INFINITY) } else { c.clip_x(f64::NEG_INFINITY, axis) };
     let image =
@@ -35,15 +36,33 @@ fn mirrored(c: &Contour, axis: f64, left: bool) -> [Contour; 2] {
     [half, image]
 }
 
-/// An SVG path through closed `loops`, drawn with `to_svg`.
-fn path(loops: &[&Contour], to_svg: &dyn Fn(DVec2) -> DVec2) -> String {
+/// How close to the symmetry plane both ends of an edge lie for it to be a cut along the plane
+/// (mm): the clipping interpolates, so its points sit on the plane up to rounding.
+const ON_PLANE_MM: f64 = 1e-6;
+
+/// An SVG path through closed `loops`, drawn with `to_svg`, leaving out the edges that lie on
+/// the plane x = `seam` (where a mirrored half meets its image, the body has no outline).
+fn path(loops: &[&Contour], seam: Option<f64>, to_svg: &dyn Fn(DVec2) -> DVec2) -> String {
     let mut d = String::new();
     for c in loops {
-        for (k, p) in c.points.iter().enumerate() {
-            let q = to_svg(*p);
-            let _ = write!(d, "{}{:.1} {:.1} ", if k == 0 { "M" } else { "L" }, q.x, q.y);
+        let n = c.points.len();
+        let on_seam = |i: usize| {
+            let (a, b) = (c.points[i], c.points[(i + 1) % n]);
+            seam.is_some_and(|x| (a.x - x).abs() < ON_PLANE_MM && (b.x - x).abs() < ON_PLANE_MM)
+        };
+        // Start just after an edge left out, if any, so each stretch is drawn in one piece.
+        let start = (0..n).find(|&i| on_seam(i)).map_or(0, |i| (i + 1) % n);
+        let mut pen_down = false;
+        for step in 0..n {
+            let i = (start + step) % n;
+            let q = to_svg(c.points[i]);
+            let _ = write!(d, "{}{:.1} {:.1} ", if pen_down { "L" } else { "M" }, q.x, q.y);
+            pen_down = !on_seam(i);
         }
-        d.push_str("Z ");
+        if pen_down {
+            let q = to_svg(c.points[start]);
+            let _ = write!(d, "L{:.1} {:.1} ", q.x, q.y);
+        }
     }
     d
 }
@@ -98,8 +117,12 @@ pub fn sections_svg(scan: &Mesh, result: &Symmetrized) -> String {
         let section = sections[k].as_ref().unwrap_or(&empty);
         let [l0, l1] = mirrored(section, m.axis, true);
         let [r0, r1] = mirrored(section, m.axis, false);
-        let curves: [Vec<&Contour>; 4] =
-            [vec![&rings[k]], vec![section], vec![&l0, &l1], vec![&r0, &r1]];
+        let curves: [(Vec<&Contour>, Option<f64>); 4] = [
+            (vec![&rings[k]], None),
+            (vec![section], None),
+            (vec![&l0, &l1], Some(m.axis)),
+            (vec![&r0, &r1], Some(m.axis)),
+        ];
         let mirrored_row = |body: &str| c.mirrored.iter().find(|r| r.body == body);
         let girth_of =
             |body: &str| mirrored_row(body).map_or(0.0, |r| [r.chest, r.waist, r.hip][k]);
@@ -123,7 +146,7 @@ pub fn sections_svg(scan: &Mesh, result: &Symmetrized) -> String {
             TITLE,
             TITLE + drawing_h
         );
-        for (k_curve, ((name, colour, width, dash), loops)) in
+        for (k_curve, ((name, colour, width, dash), (loops, seam))) in
             STYLES.iter().zip(&curves).enumerate()
         {
             let dash = if dash.is_empty() {
@@ -134,7 +157,7 @@ pub fn sections_svg(scan: &Mesh, result: &Symmetrized) -> String {
             let _ = writeln!(
                 svg,
                 r#"<path d="{}" fill="none" stroke="{colour}" stroke-width="{width}"{dash}/>"#,
-                path(loops, &to_svg).trim_end()
+                path(loops, *seam, &to_svg).trim_end()
             );
             let _ = writeln!(
                 svg,
@@ -147,4 +170,28 @@ pub fn sections_svg(scan: &Mesh, result: &Symmetrized) -> String {
     }
     svg.push_str("</svg>\n");
     svg
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_mirrored_half_is_drawn_without_its_cut_along_the_plane() {
+        let square = Contour {
+            points: vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(1.0, 0.0),
+                DVec2::new(1.0, 1.0),
+                DVec2::new(0.0, 1.0),
+            ],
+        };
+        let same = |p: DVec2| p;
+        assert_eq!(path(&[&square], Some(0.0), &same), "M0.0 0.0 L1.0 0.0 L1.0 1.0 L0.0 1.0 ");
+        assert_eq!(
+            path(&[&square], None, &same),
+            "M0.0 0.0 L1.0 0.0 L1.0 1.0 L0.0 1.0 L0.0 0.0 ",
+            "a whole section is closed"
+        );
+    }
 }

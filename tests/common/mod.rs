@@ -187,8 +187,13 @@ pub fn largest_mirror_gap(mesh: &Mesh, axis: f64) -> f64 {
 
 /// A generated customer's surface as a mesh (in the canonical frame, as the generator makes it).
 pub fn mesh_of(body: &sim::capture::SyntheticBody) -> Mesh {
+    surface_mesh(&body.surface)
+}
+
+/// A triangle surface of `sim` (a generated body's, or a simulated scan) as a mesh.
+pub fn surface_mesh(surface: &sim::capture::TriangleSurface) -> Mesh {
     Mesh::new(
-        body.surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
-        body.surface.triangles.clone(),
+        surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
+        surface.triangles.clone(),
     )
 }
