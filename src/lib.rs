@@ -13,7 +13,8 @@
 //! - [`pipeline`]: scan to mannequin in one call; [`profiles`]: the `profiles.json` format;
 //! - [`preview`]: pictures of a result: `preview.png` and `sections.svg`;
 //! - [`report`]: what `dressform info` says about a scan;
-//! - [`output`]: atomic file writes;
+//! - [`output`]: atomic file writes and all-or-nothing output sets;
+//! - [`messages`]: how problems are worded (one bounded line each);
 //! - [`setpoints`]: the set-point file (actuator id → extension, mm) the controller drives to;
 //! - [`controller`]: the host controller: drives the robotic form over serial, slcan, SocketCAN or the simulated bus;
 //! - [`makehuman`]: the CC0 MakeHuman assets (base mesh, targets, 163-bone rig, weights) and posing them;
@@ -25,6 +26,7 @@ pub mod makehuman;
 pub mod mannequin;
 pub mod measure;
 pub mod mesh;
+pub mod messages;
 pub mod output;
 pub mod pipeline;
 pub mod preview;

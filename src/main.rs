@@ -11,7 +11,8 @@ fn main() -> ExitCode {
         Ok(()) if cli::output_failed() => ExitCode::FAILURE,
         Ok(()) => ExitCode::SUCCESS,
         Err(failure) => {
-            cli::write_err(format_args!("error: {}\n", failure.message));
+            let message = dressform::messages::bounded(&failure.message);
+            cli::write_err(format_args!("error: {message}\n"));
             ExitCode::from(failure.exit_code)
         }
     }

@@ -146,7 +146,13 @@ impl Profiles {
     pub fn load(path: &Path, regions: &[Region]) -> Result<Self, ProfilesError> {
         let bytes = std::fs::read(path)
             .map_err(|source| ProfilesError::Read { path: path.to_path_buf(), source })?;
-        let profiles: Profiles = serde_json::from_slice(&bytes).map_err(|e| {
+        Self::parse(&bytes, path, regions)
+    }
+
+    /// Parses a profiles file's bytes (read from `path`, named in errors) and checks it
+    /// ([`Profiles::validate`]) for a form that shapes `regions`.
+    pub fn parse(bytes: &[u8], path: &Path, regions: &[Region]) -> Result<Self, ProfilesError> {
+        let profiles: Profiles = serde_json::from_slice(bytes).map_err(|e| {
             ProfilesError::Syntax { path: path.to_path_buf(), message: e.to_string() }
         })?;
         profiles

@@ -31,6 +31,7 @@ use serde::{Deserialize, Serialize};
 use sim::form::FormDescription;
 
 use crate::controller::safety::SafeTarget;
+use crate::messages;
 use crate::output::{WriteError, write_atomically};
 
 /// The `format` of the files this module reads and writes.
@@ -94,7 +95,7 @@ pub enum SetPointsError {
         message: String,
     },
     /// It is a set-point file, but not one for this form.
-    #[error("{}: {}", path.display(), problems.join("; "))]
+    #[error("{}: {}", path.display(), summary(problems))]
     Invalid {
         /// The file.
         path: PathBuf,
@@ -115,12 +116,32 @@ pub struct OutOfStroke {
 }
 
 fn list(offending: &[(String, f64, f64)]) -> String {
-    let items: Vec<String> = offending
-        .iter()
-        .map(|(id, asked, stroke)| format!("{id} asks {asked} mm (stroke 0..={stroke} mm)"))
-        .collect();
-    items.join(", ")
+    messages::list(offending.iter().map(|(id, asked, stroke)| {
+        let (id, asked, stroke) = (shown(id), messages::number(*asked), messages::number(*stroke));
+        format!("{id} asks {asked} mm (stroke 0..={stroke} mm)")
+    }))
 }
+
+/// How many problems a message lists.
+const PROBLEMS_SHOWN: usize = 3;
+
+/// `problems` for a message: all of a few, or how many and the first ones.
+fn summary(problems: &[String]) -> String {
+    let first = problems[..problems.len().min(PROBLEMS_SHOWN)].join("; ");
+    if problems.len() <= PROBLEMS_SHOWN {
+        first
+    } else {
+        format!("{} problems, the first {PROBLEMS_SHOWN}: {first}", problems.len())
+    }
+}
+
+/// An actuator id as messages show it (escaped, cut: ids come from files).
+fn shown(id: &str) -> String {
+    messages::quote(id.as_bytes(), ID_SHOWN)
+}
+
+/// How many characters of an actuator id a message shows.
+const ID_SHOWN: usize = 40;
 
 /// Set-points checked against a form: every target lies within its actuator's stroke.
 #[derive(Clone, Debug, PartialEq)]
@@ -192,9 +213,9 @@ impl SetPoints {
         }
         for (id, &mm) in &self.positions_mm {
             if form.actuator(id).is_none() {
-                problems.push(format!("positions_mm.{id}: the form has no actuator \"{id}\""));
+                problems.push(format!("positions_mm.{}: the form has no actuator", shown(id)));
             } else if !mm.is_finite() {
-                problems.push(format!("positions_mm.{id}: {mm} is not a finite number"));
+                problems.push(format!("positions_mm.{}: {mm} is not a finite number", shown(id)));
             }
         }
         for (ring, &mm) in &self.target_girths_mm {

@@ -1,8 +1,9 @@
-//! Round trips through every mesh format we read and write, and reading the variants we only
-//! read (ASCII and big-endian PLY, ASCII STL).
+//! Round trips through every mesh format we read and write, reading the variants we only read
+//! (ASCII and big-endian PLY, ASCII STL), and exports for CAD in every unit and up axis.
 
 use dressform::mesh::Mesh;
-use dressform::scan::format::Format;
+use dressform::scan::format::{Export, Format, Placement, UpAxis, comment_value};
+use dressform::scan::frame::Units;
 use glam::DVec3;
 use std::fmt::Write as _;
 
@@ -212,4 +213,88 @@ fn binary_ply_face_index_out_of_range_names_the_face_and_the_index() {
         let err = Format::Ply.read(&scanner_ply(&mesh.positions, &mixed)).unwrap_err();
         assert!(err.to_string().contains(expected), "{err}");
     }
+}
+
+// Exports (issue 12, "Exports for CAD"): every format, unit and up axis reads back to the
+// canonical mesh within the 0.001 mm grid, with units and axes named in the header.
+
+/// A body-sized mesh in the canonical frame (mm, Z up).
+fn canonical_body() -> Mesh {
+    sample().map_positions(|p| DVec3::new(p.x * 0.3, p.y * 0.002 - 100.0, p.z * 90.0 + 20.0))
+}
+
+/// A file point back in the canonical frame.
+fn to_canonical(p: DVec3, units: Units, up: UpAxis) -> DVec3 {
+    let p = p * units.mm();
+    match up {
+        UpAxis::Z => p,
+        UpAxis::Y => DVec3::new(p.x, -p.z, p.y),
+    }
+}
+
+#[test]
+fn exports_read_back_in_every_format_unit_and_axis() {
+    let mesh = canonical_body();
+    for format in Format::ALL {
+        for units in [Units::Mm, Units::Cm, Units::M] {
+            for up in [UpAxis::Z, UpAxis::Y] {
+                let Ok(export) = Export::new(format, Placement::Canonical { units, up }) else {
+                    assert_eq!(format, Format::Glb);
+                    continue;
+                };
+                let export = export.with_comments(["crotch: 812.5".to_string()]);
+                let file = format.decode(&export.encode(&mesh)).unwrap();
+                // STL and glb store f32: a few ten-thousandths of a mm at body size.
+                let tolerance =
+                    if matches!(format, Format::Stl | Format::Glb) { 1e-3 } else { 5e-4 };
+                for (a, b) in corners(&file.mesh).iter().zip(corners(&mesh)) {
+                    for k in 0..3 {
+                        let back = to_canonical(a[k], units, up);
+                        let off = (back - b[k]).abs().max_element();
+                        assert!(
+                            off <= tolerance + 1e-9,
+                            "{format} {units} {up:?}: {back} vs {}",
+                            b[k]
+                        );
+                    }
+                }
+                if format != Format::Stl {
+                    let c = &file.comments;
+                    assert_eq!(comment_value(c, "units"), Some(units.to_string().as_str()));
+                    let named = if up == UpAxis::Z { "+z" } else { "+y" };
+                    assert_eq!(comment_value(c, "up"), Some(named), "{format}");
+                    assert_eq!(comment_value(c, "crotch"), Some("812.5"), "{format}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn obj_numbers_are_the_shortest_at_a_thousandth_of_a_millimetre() {
+    let mesh = canonical_body().map_positions(|p| p + DVec3::splat(1.0 / 3.0));
+    let text = String::from_utf8(Export::canonical(Format::Obj).encode(&mesh)).unwrap();
+    for line in text.lines().filter(|l| l.starts_with("v ")) {
+        for number in line.split(' ').skip(1) {
+            let decimals = number.split_once('.').map_or(0, |(_, d)| d.len());
+            assert!(decimals <= 3, "{number} in {line}");
+            assert!(number.parse::<f64>().unwrap().is_finite());
+        }
+    }
+    assert!(text.starts_with("# written by dressform"), "{text}");
+    assert!(text.contains("# units: mm\n# up: +z\n"), "{text}");
+    // Writing what was read gives the same bytes: the rounding is stable.
+    let again = Format::Obj.read(text.as_bytes()).unwrap();
+    assert_eq!(Export::canonical(Format::Obj).encode(&again), text.as_bytes());
+}
+
+#[test]
+fn glb_export_passes_the_khronos_validator() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("body.glb");
+    let export = Export::canonical(Format::Glb).with_comments(["source: test".to_string()]);
+    std::fs::write(&path, export.encode(&canonical_body())).unwrap();
+    let Some(report) = crate::common::validate_gltf(&path) else { return };
+    assert_eq!(report.errors, 0, "{:#}", report.json);
+    assert_eq!(report.warnings, 0, "{:#}", report.json);
 }

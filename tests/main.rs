@@ -21,6 +21,7 @@ mod makehuman;
 mod mannequin;
 mod mannequin_quality;
 mod measurements;
+mod outputs;
 mod preview;
 mod run_end_to_end;
 mod segmentation;

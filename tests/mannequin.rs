@@ -107,8 +107,9 @@ fn symmetrize_writes_the_three_outputs_in_either_frame() {
     let scan_frame = dressform::scan::read_mesh(&out.path().join("mannequin.obj")).unwrap().0;
     let frame = scan::load(&base, &FrameOptions::default()).unwrap().frame;
     assert!(scan_frame.bounds().unwrap().size().y > 10.0, "decimetres, Y up");
+    // Both files are rounded to 0.001 mm (in their own units): within 0.002 mm of each other.
     for (p, q) in scan_frame.positions.iter().zip(&canonical.positions) {
-        assert!((frame.to_canonical(*p) - *q).length() < 1e-6, "{p} maps to {q}");
+        assert!((frame.to_canonical(*p) - *q).length() < 2e-3, "{p} maps to {q}");
     }
 }
 

@@ -1,6 +1,6 @@
 //! `dressform demo [--out DIR] [--seed N]`: the whole system on a built-in synthetic customer —
 //! generate a body with known measurements (`sim`), scan it with a typical scanner's artifacts
-//! (noise, holes, metres, Y up, turned), write and read back the scan, build the symmetric
+//! (noise, holes, metres, Y up, turned), encode the scan as PLY and read it back, build the symmetric
 //! mannequin, fit the reference form and drive the simulated form over the in-process bus —
 //! then compare the customer's true girths with the scan's and the mannequin's.
 
@@ -10,9 +10,10 @@ use super::{Failure, progress_bar};
 use dressform::controller::{DriveOptions, LinkSpec};
 use dressform::fitting::DEFAULT_GIRTH_TOLERANCE_MM;
 use dressform::mesh::{Mesh, smooth::DEFAULT_PASSES};
-use dressform::output::write_atomically;
+use dressform::output::OutputSet;
 use dressform::report::ScanInfo;
-use dressform::scan::{self, format::Format, frame::FrameOptions};
+use dressform::scan::format::{Export, Format, Placement};
+use dressform::scan::{self, frame::FrameOptions, frame::Units};
 use glam::DVec3;
 use sim::capture::{Artifacts, BodyParams, capture, generate};
 use std::path::PathBuf;
@@ -39,14 +40,18 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
     let raw = capture(&customer, &artifacts);
     let raw =
         Mesh::new(raw.positions.iter().map(|&p| DVec3::from_array(p)).collect(), raw.triangles);
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        Failure::other(format!("{}: cannot create the directory: {e}", args.out.display()))
-    })?;
+    let scanner = Placement::AsIs {
+        units: Units::M,
+        frame: format!("the scanner's: Y up, turned {} degrees", artifacts.yaw_deg),
+    };
+    let scan_file = Export::new(Format::Ply, scanner).map_err(Failure::other)?.encode(&raw);
     let scan_path = args.out.join("scan.ply");
-    write_atomically(&scan_path, &Format::Ply.encode(&raw)).map_err(Failure::other)?;
     bar.inc(1);
     bar.set_message("reading the scan back");
-    let mut scan = scan::load(&scan_path, &FrameOptions::default()).map_err(Failure::bad_input)?;
+    let mut scan = scan::from_bytes(&scan_file, &scan_path, &FrameOptions::default())
+        .map_err(Failure::bad_input)?;
+    let mut outputs = OutputSet::new();
+    outputs.add("scan.ply", scan_file);
     let info = ScanInfo::new(&scan);
     scan.body.taubin_smooth(DEFAULT_PASSES);
     bar.finish_and_clear();
@@ -73,7 +78,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         options: &DriveOptions::default(),
         girth_tolerance: DEFAULT_GIRTH_TOLERANCE_MM,
     };
-    let (result, shape) = shape_form(&scan, &sim::form::reference(), &drive, &args.out)?;
+    let (result, shape) = shape_form(&scan, &sim::form::reference(), &drive, &args.out, outputs)?;
     outln!();
     outln!("  {:<12} {:>9} {:>9} {:>11}", "measure (mm)", "customer", "scan", "mannequin");
     let c = &result.comparison;

@@ -42,6 +42,10 @@ mod status;
 mod symmetrize;
 
 use clap::{Parser, Subcommand};
+use dressform::mesh::Mesh;
+use dressform::messages;
+use dressform::scan::Scan;
+use dressform::scan::format::{Export, Format, Placement, UpAxis};
 use dressform::scan::frame::{Direction, FrameOptions, Units};
 use std::io::{ErrorKind, Write};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -113,6 +117,110 @@ impl FrameArgs {
     }
 }
 
+/// The scan's frame in commands that also write a mesh (whose own `--units` and `--up` are in
+/// [`ExportArgs`]).
+#[derive(Debug, Clone, clap::Args)]
+pub struct ScanFrameArgs {
+    /// The scan's length unit [default: detected from the body's height].
+    #[arg(long, value_enum)]
+    scan_units: Option<Units>,
+    /// The scan's up axis: x, y, z, -x, -y or -z [default: detected].
+    #[arg(long, allow_hyphen_values = true)]
+    scan_up: Option<Direction>,
+    /// The axis the subject faces in the scan: x, y, z, -x, -y or -z [default: detected].
+    #[arg(long, allow_hyphen_values = true)]
+    scan_facing: Option<Direction>,
+}
+
+impl ScanFrameArgs {
+    fn options(&self) -> FrameOptions {
+        FrameOptions { units: self.scan_units, up: self.scan_up, facing: self.scan_facing }
+    }
+}
+
+/// How a command writes its output mesh (see [`Export`]).
+#[derive(Debug, Clone, clap::Args)]
+pub struct ExportArgs {
+    /// The mesh's file format (glb: binary glTF, metres, Y up).
+    #[arg(long, value_enum, default_value_t = MeshFormat::Obj)]
+    format: MeshFormat,
+    /// The mesh's length unit [default: mm; m for glb].
+    #[arg(long, value_enum, conflicts_with = "scan_frame")]
+    units: Option<MeshUnits>,
+    /// The mesh's up axis [default: z, the canonical frame; y for glb].
+    #[arg(long, value_enum, conflicts_with = "scan_frame")]
+    up: Option<MeshUp>,
+    /// Write the mesh in the scan's own units and axes (default: the canonical frame).
+    #[arg(long)]
+    scan_frame: bool,
+}
+
+/// `--format`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum MeshFormat {
+    Obj,
+    Ply,
+    Stl,
+    Glb,
+}
+
+/// `--units` of an output mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum MeshUnits {
+    Mm,
+    Cm,
+    M,
+}
+
+/// `--up` of an output mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum MeshUp {
+    Z,
+    Y,
+}
+
+impl ExportArgs {
+    /// The export of a mesh of `scan` (checked: glb is metres and Y up).
+    fn export(&self, scan: &Scan) -> Result<Export, Failure> {
+        let format = match self.format {
+            MeshFormat::Obj => Format::Obj,
+            MeshFormat::Ply => Format::Ply,
+            MeshFormat::Stl => Format::Stl,
+            MeshFormat::Glb => Format::Glb,
+        };
+        let usual = Export::canonical(format).placement;
+        let placement = match (&usual, self.scan_frame) {
+            (_, true) => Placement::AsIs {
+                units: scan.frame.units,
+                frame: format!(
+                    "the scan's own ({}, up {})",
+                    messages::path(&scan.source),
+                    scan.frame.up
+                ),
+            },
+            (Placement::Canonical { units, up }, false) => Placement::Canonical {
+                units: self.units.map_or(*units, |u| match u {
+                    MeshUnits::Mm => Units::Mm,
+                    MeshUnits::Cm => Units::Cm,
+                    MeshUnits::M => Units::M,
+                }),
+                up: self.up.map_or(*up, |u| match u {
+                    MeshUp::Z => UpAxis::Z,
+                    MeshUp::Y => UpAxis::Y,
+                }),
+            },
+            (placement, false) => placement.clone(),
+        };
+        Export::new(format, placement).map_err(Failure::bad_input)
+    }
+
+    /// `mesh` (in the canonical frame) as it goes into the file: moved back into the scan's
+    /// frame with `--scan-frame`.
+    fn placed(&self, scan: &Scan, mesh: &Mesh) -> Mesh {
+        if self.scan_frame { mesh.map_positions(|p| scan.frame.to_scan(p)) } else { mesh.clone() }
+    }
+}
+
 /// A command that failed: the message to print and the process exit code.
 #[derive(Debug)]
 pub struct Failure {
@@ -177,9 +285,9 @@ pub fn output_failed() -> bool {
     OUTPUT_FAILED.load(Ordering::Relaxed)
 }
 
-/// Prints a warning about `file` on standard error.
+/// Prints a warning about `file` on standard error (bounded: see [`messages::bounded`]).
 fn warn(file: &str, message: &str) {
-    errln!("warning: {file}: {message}");
+    errln!("warning: {}", messages::bounded(&format!("{file}: {message}")));
 }
 
 /// A progress bar on standard error for `steps` steps; hidden in `--json` mode and when

@@ -12,12 +12,12 @@ use dressform::controller::{DriveOptions, LinkSpec};
 use dressform::fitting::{Fit, ShapeOutcome, compare, fit, region_of};
 use dressform::mannequin::MannequinOptions;
 use dressform::mesh::topology;
-use dressform::output::write_atomically;
+use dressform::output::OutputSet;
 use dressform::pipeline::{STEPS, Symmetrized, symmetrize};
 use dressform::preview::{preview_png, sections_svg};
 use dressform::profiles::Profiles;
 use dressform::regions::Region;
-use dressform::scan::{self, Scan, format::Format};
+use dressform::scan::{self, Scan, format::Export, format::Format};
 use dressform::setpoints::SetPoints;
 use sim::form::FormDescription;
 use std::collections::BTreeMap;
@@ -57,7 +57,7 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     let link = args.link.spec();
     let drive =
         Drive { link: &link, sim: &args.sim, options: &args.shape.options(), girth_tolerance };
-    let (_, shape) = shape_form(&scan, &form, &drive, &args.out)?;
+    let (_, shape) = shape_form(&scan, &form, &drive, &args.out, OutputSet::new())?;
     shape_verdict(&shape)
 }
 
@@ -73,14 +73,16 @@ pub struct Drive<'a> {
     pub girth_tolerance: f64,
 }
 
-/// The chain shared by `run` and `demo`: mannequin, set-points, drive, report. Returns the
-/// mannequin and its measurements, and how well the form took the shape (the caller exits
-/// 3 when it did not).
+/// The chain shared by `run` and `demo`: mannequin, set-points, drive, report. The outputs are
+/// committed into `out` with the files already in `outputs`, as one set. Returns the mannequin
+/// and its measurements, and how well the form took the shape (the caller exits 3 when it did
+/// not).
 pub fn shape_form(
     scan: &Scan,
     form: &FormDescription,
     drive: &Drive,
     out: &Path,
+    outputs: OutputSet,
 ) -> Result<(Symmetrized, ShapeOutcome), Failure> {
     let file = scan.source.display().to_string();
     let bar = progress_bar(false, STEPS.len() as u64 + 1);
@@ -93,7 +95,7 @@ pub fn shape_form(
     let profiles = Profiles::of(&result.mannequin, &result.comparison.levels);
     let fitted = fit(&profiles, form).map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
     let setpoints = setpoints_of(&fitted);
-    write_outputs(out, scan, &result, &profiles, &setpoints)?;
+    write_outputs(out, scan, outputs, &result, &profiles, &setpoints)?;
     bar.finish_and_clear();
 
     outln!("Symmetric mannequin and set-points written to {}.", out.display());
@@ -126,6 +128,7 @@ pub fn shape_form(
 fn write_outputs(
     out: &Path,
     scan: &Scan,
+    mut outputs: OutputSet,
     result: &Symmetrized,
     profiles: &Profiles,
     setpoints: &SetPoints,
@@ -133,20 +136,15 @@ fn write_outputs(
     std::fs::create_dir_all(out).map_err(|e| {
         Failure::other(format!("{}: cannot create the directory: {e}", out.display()))
     })?;
-    let outputs = [
-        ("mannequin.obj", Format::Obj.encode(&result.mannequin.mesh)),
-        ("profiles.json", serde_json::to_vec_pretty(profiles).map_err(Failure::other)?),
-        (
-            "measurements.json",
-            serde_json::to_vec_pretty(&result.comparison).map_err(Failure::other)?,
-        ),
-        ("preview.png", preview_png(&scan.body, result)),
-        ("sections.svg", sections_svg(&scan.body, result).into_bytes()),
-    ];
-    for (name, bytes) in &outputs {
-        write_atomically(&out.join(name), bytes).map_err(Failure::other)?;
-    }
-    setpoints.save(&out.join("setpoints.json")).map_err(Failure::other)
+    let export = Export::canonical(Format::Obj);
+    outputs.add(export.file_name("mannequin"), export.encode(&result.mannequin.mesh));
+    outputs.add("profiles.json", serde_json::to_vec_pretty(profiles).map_err(Failure::other)?);
+    let measurements = serde_json::to_vec_pretty(&result.comparison).map_err(Failure::other)?;
+    outputs.add("measurements.json", measurements);
+    outputs.add("setpoints.json", setpoints.to_json_string());
+    outputs.add("preview.png", preview_png(&scan.body, result));
+    outputs.add("sections.svg", sections_svg(&scan.body, result));
+    outputs.commit(out).map_err(Failure::other)
 }
 
 /// Scan, mannequin and form girths at every ring: the scan's section where the ring shapes

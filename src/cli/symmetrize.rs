@@ -1,15 +1,16 @@
 //! `dressform symmetrize <scan> -o <dir> [--torso-layers N] [--leg-layers N] [--rays N]
-//! [--preserve tape|contour] [--scan-frame] [--json]`.
+//! [--preserve tape|contour] [--format obj|ply|stl|glb] [--units mm|cm|m] [--up z|y]
+//! [--scan-frame] [--json]`.
 
-use super::{Failure, FrameArgs, SmoothArgs, progress_bar, warn};
+use super::{ExportArgs, Failure, ScanFrameArgs, SmoothArgs, progress_bar, warn};
 use dressform::mannequin::MannequinOptions;
 use dressform::measure::Comparison;
 use dressform::mesh::topology;
-use dressform::output::write_atomically;
+use dressform::output::OutputSet;
 use dressform::pipeline::{STEPS, symmetrize};
 use dressform::preview::{preview_png, sections_svg};
 use dressform::profiles::Profiles;
-use dressform::scan::{self, format::Format};
+use dressform::scan;
 use dressform::symmetry::Preserve;
 use std::path::PathBuf;
 
@@ -17,8 +18,8 @@ use std::path::PathBuf;
 pub struct SymmetrizeArgs {
     /// The scan: an .obj, .ply or .stl file.
     scan: PathBuf,
-    /// Output directory (created if missing): mannequin.obj, profiles.json, measurements.json,
-    /// preview.png, sections.svg.
+    /// Output directory (created if missing): mannequin.obj (or .ply, .stl, .glb),
+    /// profiles.json, measurements.json, preview.png, sections.svg, replaced as a whole.
     #[arg(short, long)]
     out: PathBuf,
     /// Torso layers.
@@ -33,14 +34,13 @@ pub struct SymmetrizeArgs {
     /// The girth every layer keeps: tape (convex hull) or contour (the paper's rule).
     #[arg(long, value_enum, default_value_t = Preserve::Tape)]
     preserve: Preserve,
-    /// Write mannequin.obj in the scan's own units and axes (default: the canonical frame).
-    #[arg(long)]
-    scan_frame: bool,
+    #[command(flatten)]
+    export: ExportArgs,
     /// Print measurements.json to standard output instead of the table.
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    frame: FrameArgs,
+    frame: ScanFrameArgs,
     #[command(flatten)]
     smooth: SmoothArgs,
 }
@@ -49,6 +49,7 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     let bar = progress_bar(args.json, STEPS.len() as u64 + 2);
     bar.set_message("reading the scan");
     let mut scan = scan::load(&args.scan, &args.frame.options()).map_err(Failure::bad_input)?;
+    let export = args.export.export(&scan)?;
     scan.body.taubin_smooth(args.smooth.smooth);
     let file = scan.source.display().to_string();
     for w in scan.cleaning.warnings().into_iter().chain(topology(&scan.body).warnings()) {
@@ -71,23 +72,16 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     std::fs::create_dir_all(&args.out).map_err(|e| {
         Failure::other(format!("{}: cannot create the directory: {e}", args.out.display()))
     })?;
-    let mesh = &result.mannequin.mesh;
-    let mesh =
-        if args.scan_frame { mesh.map_positions(|p| scan.frame.to_scan(p)) } else { mesh.clone() };
+    let mesh = args.export.placed(&scan, &result.mannequin.mesh);
     let measurements = pretty_json(&result.comparison)?;
-    let outputs = [
-        ("mannequin.obj", Format::Obj.encode(&mesh)),
-        (
-            "profiles.json",
-            pretty_json(&Profiles::of(&result.mannequin, &result.comparison.levels))?.into_bytes(),
-        ),
-        ("measurements.json", measurements.clone().into_bytes()),
-        ("preview.png", preview_png(&scan.body, &result)),
-        ("sections.svg", sections_svg(&scan.body, &result).into_bytes()),
-    ];
-    for (name, bytes) in &outputs {
-        write_atomically(&args.out.join(name), bytes).map_err(Failure::other)?;
-    }
+    let mut outputs = OutputSet::new();
+    outputs.add(export.file_name("mannequin"), export.encode(&mesh));
+    let profiles = Profiles::of(&result.mannequin, &result.comparison.levels);
+    outputs.add("profiles.json", pretty_json(&profiles)?);
+    outputs.add("measurements.json", measurements.clone());
+    outputs.add("preview.png", preview_png(&scan.body, &result));
+    outputs.add("sections.svg", sections_svg(&scan.body, &result));
+    outputs.commit(&args.out).map_err(Failure::other)?;
     bar.finish_and_clear();
     if args.json {
         outln!("{measurements}");

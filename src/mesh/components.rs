@@ -92,34 +92,32 @@ pub fn components(mesh: &Mesh) -> Components {
     Components { parts, of_vertex }
 }
 
-/// Sums something over the items `0..items` of each of `pieces` pieces, in parallel:
-/// `piece(i)` is item `i`'s piece, `sum` gives the total over a range of items of one piece,
-/// and `T::merge` adds totals. Runs of items of one piece are summed at once.
+/// Sums something over the items `0..items` of each of `pieces` pieces, in parallel and in a
+/// fixed order ([`super::reduce`]): `piece(i)` is item `i`'s piece, `sum` gives the total over
+/// a range of items of one piece, and `T::merge` adds totals. Runs of items of one piece are
+/// summed at once.
 fn per_piece<T: Merge + Default + Clone + Send>(
     items: usize,
     piece: impl Fn(usize) -> u32 + Sync,
     pieces: usize,
     sum: impl Fn(Range<usize>) -> T + Sync,
 ) -> Vec<T> {
-    const BLOCK: usize = 1 << 14;
     let empty = || vec![T::default(); pieces];
-    (0..items.div_ceil(BLOCK))
-        .into_par_iter()
-        .fold(empty, |mut totals, block| {
-            let end = ((block + 1) * BLOCK).min(items);
-            let mut first = block * BLOCK;
-            while first < end {
-                let id = piece(first);
-                let run_end = (first + 1..end).find(|&i| piece(i) != id).unwrap_or(end);
-                totals[id as usize].merge(sum(first..run_end));
-                first = run_end;
-            }
-            totals
-        })
-        .reduce(empty, |mut x, y| {
-            x.iter_mut().zip(y).for_each(|(a, b)| a.merge(b));
-            x
-        })
+    let blocks = super::reduce::blocks(items, |block| {
+        let mut totals = empty();
+        let mut first = block.start;
+        while first < block.end {
+            let id = piece(first);
+            let run_end = (first + 1..block.end).find(|&i| piece(i) != id).unwrap_or(block.end);
+            totals[id as usize].merge(sum(first..run_end));
+            first = run_end;
+        }
+        totals
+    });
+    blocks.into_iter().fold(empty(), |mut x, y| {
+        x.iter_mut().zip(y).for_each(|(a, b)| a.merge(b));
+        x
+    })
 }
 
 /// Totals that add up.

@@ -5,6 +5,7 @@
 
 mod adjacency;
 mod components;
+pub mod reduce;
 pub mod smooth;
 mod topology;
 mod weld;

@@ -42,7 +42,9 @@ impl Topology {
     pub fn warnings(&self) -> Vec<String> {
         let mut w = Vec::new();
         if !self.boundary_loops.is_empty() {
-            w.push(format!("the body has {} holes (boundary loops)", self.boundary_loops.len()));
+            let n = self.boundary_loops.len();
+            let holes = if n == 1 { "hole" } else { "holes" };
+            w.push(format!("the body has {n} {holes} (boundary loops)"));
         }
         if !self.is_manifold() {
             w.push(format!(
@@ -77,6 +79,7 @@ pub fn topology(mesh: &Mesh) -> Topology {
             let mut topo = Topology::default();
             let mut boundary = Vec::new();
             let mut group: Vec<(u32, u32)> = Vec::new();
+            let (mut scratch, mut parent) = (Vec::new(), Vec::new());
             for v in c * chunk..((c + 1) * chunk).min(n) {
                 group.clear();
                 group.extend(by_vertex.of(v).iter().map(|&h| {
@@ -99,7 +102,7 @@ pub fn topology(mesh: &Mesh) -> Topology {
                         _ => topo.non_manifold_edges += 1,
                     }
                 }
-                if fans(mesh, v as u32, around.of(v)) > 1 {
+                if fans(mesh, v as u32, around.of(v), &mut scratch, &mut parent) > 1 {
                     topo.non_manifold_vertices += 1;
                 }
             }
@@ -121,36 +124,48 @@ pub fn topology(mesh: &Mesh) -> Topology {
 }
 
 /// How many fans the triangles around vertex `v` form: triangles are in one fan when they
-/// are linked through edges at `v` (sharing `v` and one more vertex).
-fn fans(mesh: &Mesh, v: u32, triangles: &[u32]) -> usize {
-    let n = triangles.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
+/// are linked through edges at `v` (sharing `v` and one more vertex). Sorting the triangles'
+/// other corners brings the ones sharing an edge together, so a vertex of degree d costs
+/// O(d log d), not the O(d²) of comparing every pair (a million-triangle fan round one vertex
+/// is a valid mesh). `scratch` and `parent` are reused between vertices.
+fn fans(
+    mesh: &Mesh,
+    v: u32,
+    triangles: &[u32],
+    scratch: &mut Vec<(u32, u32)>,
+    parent: &mut Vec<u32>,
+) -> usize {
+    scratch.clear();
+    for (i, &t) in triangles.iter().enumerate() {
+        let others = mesh.triangles[t as usize].into_iter().filter(|&x| x != v);
+        scratch.extend(others.map(|x| (x, i as u32)));
+    }
+    scratch.sort_unstable();
+    parent.clear();
+    parent.extend(0..triangles.len() as u32);
+    fn root(parent: &mut [u32], mut i: u32) -> u32 {
+        while parent[i as usize] != i {
+            parent[i as usize] = parent[parent[i as usize] as usize];
+            i = parent[i as usize];
         }
         i
     }
-    let others = |t: u32| mesh.triangles[t as usize];
-    for i in 0..n {
-        for j in i + 1..n {
-            let (a, b) = (others(triangles[i]), others(triangles[j]));
-            if a.iter().any(|&x| x != v && b.contains(&x)) {
-                let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
-                parent[ri] = rj;
-            }
+    for run in scratch.chunk_by(|a, b| a.0 == b.0) {
+        for pair in run.windows(2) {
+            let (a, b) = (root(parent, pair[0].1), root(parent, pair[1].1));
+            parent[a as usize] = b;
         }
     }
-    (0..n).filter(|&i| root(&mut parent, i) == i).count()
+    (0..triangles.len() as u32).filter(|&i| root(parent, i) == i).count()
 }
 
 /// Chains directed boundary edges into loops. Where several boundary edges leave one vertex
 /// (a non-manifold boundary), any unused one is taken; a chain that cannot close is still
-/// reported as one (open) loop so that every boundary edge belongs to exactly one loop.
+/// reported as one (open) loop so that every boundary edge belongs to exactly one loop. Each
+/// edge is taken from its vertex's list once: linear time, however many edges meet at a vertex.
 fn chain_loops(edges: &[(u32, u32)]) -> Vec<Vec<u32>> {
     let mut leaving: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
-    for (i, &(a, _)) in edges.iter().enumerate() {
+    for (i, &(a, _)) in edges.iter().enumerate().rev() {
         leaving.entry(a).or_default().push(i);
     }
     let mut used = vec![false; edges.len()];
@@ -168,8 +183,14 @@ fn chain_loops(edges: &[(u32, u32)]) -> Vec<Vec<u32>> {
                 break;
             }
             chain.push(next_vertex);
-            let next =
-                leaving.get(&next_vertex).and_then(|c| c.iter().copied().find(|&e| !used[e]));
+            let next = leaving.get_mut(&next_vertex).and_then(|list| {
+                while let Some(e) = list.pop() {
+                    if !used[e] {
+                        return Some(e);
+                    }
+                }
+                None
+            });
             match next {
                 Some(e) => at = e,
                 None => break,
@@ -228,6 +249,42 @@ mod tests {
         assert!(t.is_closed());
         assert_eq!(t.non_manifold_edges, 0);
         assert_eq!(t.non_manifold_vertices, 1);
+    }
+
+    #[test]
+    fn fans_round_one_vertex_are_counted_in_linear_time() {
+        // A closed disk of n triangles round vertex 0 (one fan), then the same disk cut into
+        // two half-disks that touch only at the centre (two fans).
+        let n = 200_000u32;
+        let mut p = vec![DVec3::ZERO];
+        p.extend((0..n).map(|i| {
+            let a = std::f64::consts::TAU * f64::from(i) / f64::from(n);
+            DVec3::new(a.cos(), a.sin(), 0.0)
+        }));
+        let disk: Vec<[u32; 3]> = (0..n).map(|i| [0, 1 + i, 1 + (i + 1) % n]).collect();
+        let mesh = Mesh::new(p.clone(), disk.clone());
+        let t = topology(&mesh);
+        assert_eq!((t.non_manifold_vertices, t.boundary_loops.len()), (0, 1));
+        let mut cut = disk;
+        cut[(n / 2) as usize - 1][2] = n + 1;
+        cut[n as usize - 1][2] = n + 2;
+        p.extend([p[1 + (n / 2) as usize], p[1]]);
+        let t = topology(&Mesh::new(p, cut));
+        assert_eq!(t.non_manifold_vertices, 1);
+        assert_eq!(t.boundary_edges, n as usize + 4, "the rim and four radial edges");
+    }
+
+    #[test]
+    fn boundary_loops_through_one_vertex_of_many_triangles() {
+        // n separate triangles sharing only vertex 0: n fans, n boundary loops.
+        let n = 100_000u32;
+        let p: Vec<DVec3> =
+            (0..=2 * n).map(|i| DVec3::new(f64::from(i), f64::from(i % 7), 0.0)).collect();
+        let star: Vec<[u32; 3]> = (0..n).map(|i| [0, 1 + 2 * i, 2 + 2 * i]).collect();
+        let t = topology(&Mesh::new(p, star));
+        assert_eq!(t.non_manifold_vertices, 1);
+        assert_eq!(t.boundary_loops.len(), n as usize);
+        assert!(t.boundary_loops.iter().all(|l| l.len() == 3));
     }
 
     #[test]

@@ -12,6 +12,7 @@
 //! [`crate::mesh::topology`] and [`Topology::warnings`].
 
 use crate::mesh::{Aabb, Mesh, components};
+use crate::messages::number;
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -45,7 +46,7 @@ pub struct DroppedComponent {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CleanError {
     /// A vertex with NaN or infinite coordinates.
-    #[error("vertex {vertex} has a non-finite coordinate ({x}, {y}, {z})")]
+    #[error("vertex {vertex} has a non-finite coordinate ({}, {}, {})", number(*x), number(*y), number(*z))]
     NonFinite {
         /// Vertex number (0-based, file order).
         vertex: usize,

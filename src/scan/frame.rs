@@ -19,7 +19,6 @@
 use crate::mesh::{Aabb, Mesh};
 use crate::slice::sections;
 use glam::{DMat3, DVec2, DVec3};
-use rayon::prelude::*;
 use serde::Serialize;
 use std::fmt;
 use std::str::FromStr;
@@ -142,8 +141,8 @@ pub struct FrameOptions {
 pub enum FrameError {
     /// The height matches no unit for a person.
     #[error(
-        "the body is {height:.4} units tall along {up}, which is 0.5-2.5 m in none of m, dm, cm, mm; \
-         pass --units (and check --up)"
+        "the body is {} units tall along {up}, which is 0.5-2.5 m in none of m, dm, cm, mm; \
+         pass --units (and check --up)", crate::messages::number(*height)
     )]
     UnknownUnits {
         /// Height in the file's units.
@@ -276,22 +275,22 @@ impl Moments {
     }
 }
 
-/// Sums `add(moments, centroid, area)` over the triangles of `mesh`, in parallel.
+/// Sums `add(moments, centroid, area)` over the triangles of `mesh`, in parallel and in a
+/// fixed order (the same bits on every run; see [`crate::mesh::reduce`]).
 fn accumulate<const N: usize>(
     mesh: &Mesh,
     add: impl Fn(&mut [Moments; N], DVec3, f64) + Sync,
 ) -> [Moments; N] {
-    mesh.triangles
-        .par_iter()
-        .fold(
-            || [Moments::default(); N],
-            |mut acc, tri| {
-                let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
-                add(&mut acc, (a + b + c) / 3.0, 0.5 * (b - a).cross(c - a).length());
-                acc
-            },
-        )
-        .reduce(|| [Moments::default(); N], |x, y| std::array::from_fn(|k| x[k].merge(y[k])))
+    crate::mesh::reduce::fold(
+        mesh.triangles.len(),
+        || [Moments::default(); N],
+        |mut acc, t| {
+            let [a, b, c] = mesh.triangles[t].map(|v| mesh.positions[v as usize]);
+            add(&mut acc, (a + b + c) / 3.0, 0.5 * (b - a).cross(c - a).length());
+            acc
+        },
+        |x, y| std::array::from_fn(|k| x[k].merge(y[k])),
+    )
 }
 
 /// The smallest ratio of height to the largest horizontal extent of a standing person: arms

@@ -10,8 +10,9 @@ pub mod format;
 pub mod frame;
 
 use crate::mesh::{Aabb, Mesh};
+use crate::messages;
 use clean::{CleanError, CleaningReport};
-use format::{Format, ReadError};
+use format::{Format, MeshFile, ReadError};
 use frame::{CanonicalFrame, FrameError, FrameOptions};
 use std::path::{Path, PathBuf};
 
@@ -30,13 +31,16 @@ pub struct Scan {
     pub frame: CanonicalFrame,
     /// The body in the canonical frame (mm, Z up, floor at 0, +X left, facing -Y).
     pub body: Mesh,
+    /// The comments of the file's header (see [`MeshFile::comments`]); none for a mesh that
+    /// came from no file.
+    pub comments: Vec<String>,
 }
 
 /// Why a scan could not be loaded. Every message starts with the file's name.
 #[derive(Debug, thiserror::Error)]
 pub enum ScanError {
     /// The file could not be opened or read.
-    #[error("{}: cannot read: {source}", path.display())]
+    #[error("{}: cannot read: {source}", messages::path(path))]
     Io {
         /// The file.
         path: PathBuf,
@@ -44,14 +48,26 @@ pub enum ScanError {
         #[source]
         source: std::io::Error,
     },
+    /// Not a regular file (a directory, a FIFO, a device): reading it could block forever or
+    /// never end.
+    #[error("{}: {what}, not a regular file", messages::path(path))]
+    NotAFile {
+        /// The file.
+        path: PathBuf,
+        /// What it is.
+        what: &'static str,
+    },
     /// The extension names no format we read.
-    #[error("{}: unknown mesh format; expected a .obj, .ply or .stl file", path.display())]
+    #[error(
+        "{}: unknown mesh format; expected a .obj, .ply, .stl or .glb file",
+        messages::path(path)
+    )]
     UnknownFormat {
         /// The file.
         path: PathBuf,
     },
     /// The bytes are not a mesh in the format.
-    #[error("{}: {format}: {error}", path.display())]
+    #[error("{}: {format}: {error}", messages::path(path))]
     Read {
         /// The file.
         path: PathBuf,
@@ -61,7 +77,7 @@ pub enum ScanError {
         error: ReadError,
     },
     /// The mesh is not usable as a body.
-    #[error("{}: {error}", path.display())]
+    #[error("{}: {error}", messages::path(path))]
     Clean {
         /// The file.
         path: PathBuf,
@@ -69,7 +85,7 @@ pub enum ScanError {
         error: CleanError,
     },
     /// The canonical frame could not be found.
-    #[error("{}: {error}", path.display())]
+    #[error("{}: {error}", messages::path(path))]
     Frame {
         /// The file.
         path: PathBuf,
@@ -80,16 +96,21 @@ pub enum ScanError {
 
 /// Reads a mesh file in the format its extension names, without cleaning it.
 pub fn read_mesh(path: &Path) -> Result<(Mesh, Format), ScanError> {
+    read_mesh_file(path).map(|(file, format)| (file.mesh, format))
+}
+
+/// Reads a mesh file in the format its extension names, with its header comments, without
+/// cleaning it.
+pub fn read_mesh_file(path: &Path) -> Result<(MeshFile, Format), ScanError> {
     let format =
         Format::from_path(path).ok_or_else(|| ScanError::UnknownFormat { path: path.into() })?;
-    let bytes =
-        FileBytes::open(path).map_err(|source| ScanError::Io { path: path.into(), source })?;
-    let mesh = format.read(&bytes).map_err(|error| ScanError::Read {
+    let bytes = FileBytes::open(path)?;
+    let file = format.decode(&bytes).map_err(|error| ScanError::Read {
         path: path.into(),
         format,
         error,
     })?;
-    Ok((mesh, format))
+    Ok((file, format))
 }
 
 /// A file's bytes: mapped into memory where the system allows it, read otherwise.
@@ -97,22 +118,62 @@ pub fn read_mesh(path: &Path) -> Result<(Mesh, Format), ScanError> {
 /// Mapping a million-triangle scan costs about a tenth of reading it (no copy, and no fresh
 /// memory for the kernel to clear). The catch of any file mapping: if another program
 /// truncates the file while it is being read, the process is stopped by SIGBUS. Scans reach
-/// us as finished files, so the speed is worth it (ripgrep makes the same trade).
+/// us as finished files, so the speed is worth it (ripgrep makes the same trade); files
+/// smaller than [`MAP_FROM`] are copied instead, which keeps the risk to large scans.
 enum FileBytes {
     Mapped(memmap2::Mmap),
     Read(Vec<u8>),
 }
 
+/// Files from this size on are mapped rather than copied (a copy of a few pages costs less
+/// than setting up a mapping).
+const MAP_FROM: u64 = 1 << 20;
+
 impl FileBytes {
-    fn open(path: &Path) -> std::io::Result<FileBytes> {
-        let file = std::fs::File::open(path)?;
+    /// Opens `path` if it is a regular file (or a link to one). It is opened without waiting
+    /// (a FIFO with no writer would block a plain open forever), then checked.
+    fn open(path: &Path) -> Result<FileBytes, ScanError> {
+        let io = |source| ScanError::Io { path: path.into(), source };
+        let mut options = std::fs::OpenOptions::new();
+        options.read(true);
+        #[cfg(unix)]
+        std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NONBLOCK);
+        let file = options.open(path).map_err(io)?;
+        let meta = file.metadata().map_err(io)?;
+        if !meta.is_file() {
+            return Err(ScanError::NotAFile { path: path.into(), what: kind_of(&meta) });
+        }
+        if meta.len() < MAP_FROM {
+            let mut bytes = Vec::with_capacity(meta.len() as usize);
+            std::io::Read::read_to_end(&mut &file, &mut bytes).map_err(io)?;
+            return Ok(FileBytes::Read(bytes));
+        }
         // SAFETY: the map is read-only and dropped before we return to the caller; see the
         // type's documentation for what happens if the file shrinks meanwhile.
         match unsafe { memmap2::Mmap::map(&file) } {
             Ok(map) => Ok(FileBytes::Mapped(map)),
-            Err(_) => std::fs::read(path).map(FileBytes::Read),
+            Err(_) => std::fs::read(path).map(FileBytes::Read).map_err(io),
         }
     }
+}
+
+/// What a file that is not a regular one is.
+fn kind_of(meta: &std::fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_fifo() {
+            return "a FIFO (named pipe)";
+        }
+        if t.is_char_device() || t.is_block_device() {
+            return "a device";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    if meta.is_dir() { "a directory" } else { "a special file" }
 }
 
 impl std::ops::Deref for FileBytes {
@@ -127,8 +188,25 @@ impl std::ops::Deref for FileBytes {
 
 /// Loads the scan at `path`: read, clean, canonical frame.
 pub fn load(path: &Path, options: &FrameOptions) -> Result<Scan, ScanError> {
-    let (mesh, _) = read_mesh(path)?;
-    from_mesh(mesh, path, options)
+    let (file, _) = read_mesh_file(path)?;
+    let mut scan = from_mesh(file.mesh, path, options)?;
+    scan.comments = file.comments;
+    Ok(scan)
+}
+
+/// Loads a scan from `bytes` in the format `source`'s extension names (`source` names it in
+/// messages): read, clean, canonical frame.
+pub fn from_bytes(bytes: &[u8], source: &Path, options: &FrameOptions) -> Result<Scan, ScanError> {
+    let format = Format::from_path(source)
+        .ok_or_else(|| ScanError::UnknownFormat { path: source.into() })?;
+    let file = format.decode(bytes).map_err(|error| ScanError::Read {
+        path: source.into(),
+        format,
+        error,
+    })?;
+    let mut scan = from_mesh(file.mesh, source, options)?;
+    scan.comments = file.comments;
+    Ok(scan)
 }
 
 /// Cleans `mesh` (as a scanner delivered it) and moves it into the canonical frame; `source`
@@ -141,7 +219,8 @@ pub fn from_mesh(mesh: Mesh, source: &Path, options: &FrameOptions) -> Result<Sc
         .map_err(|error| ScanError::Frame { path: source.into(), error })?;
     body.transform(|p| frame.to_canonical(p));
     frame.centre_on_torso(&mut body);
-    Ok(Scan { source: source.into(), raw_vertices, raw_triangles, cleaning, frame, body })
+    let source = source.into();
+    Ok(Scan { source, raw_vertices, raw_triangles, cleaning, frame, body, comments: Vec::new() })
 }
 
 /// Serialises a box as `{"min": [x, y, z], "max": [x, y, z]}`.

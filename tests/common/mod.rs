@@ -185,6 +185,20 @@ pub fn largest_mirror_gap(mesh: &Mesh, axis: f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// A synthetic customer (the sim generator's default body) scanned with a typical scanner's
+/// artifacts (noise, holes, metres, Y up, turned; `seed` picks them), written to
+/// `dir/scan.ply`.
+pub fn synthetic_scan(dir: &std::path::Path, seed: u64) -> PathBuf {
+    use sim::capture::{Artifacts, BodyParams, capture, generate};
+    let body = generate(&BodyParams::default()).expect("the default body generates");
+    let raw = capture(&body, &Artifacts::typical_scanner(seed));
+    let mesh =
+        Mesh::new(raw.positions.iter().map(|&p| DVec3::from_array(p)).collect(), raw.triangles);
+    let path = dir.join("scan.ply");
+    std::fs::write(&path, dressform::scan::format::Format::Ply.encode(&mesh)).expect("writable");
+    path
+}
+
 /// A generated customer's surface as a mesh (in the canonical frame, as the generator makes it).
 pub fn mesh_of(body: &sim::capture::SyntheticBody) -> Mesh {
     surface_mesh(&body.surface)

@@ -1,0 +1,15 @@
+//! `profiles.json` on any bytes: parsing never panics, and profiles that parse are fitted to
+//! the reference form (what `dressform setpoints` does next) without panicking.
+#![no_main]
+
+use dressform::profiles::Profiles;
+use libfuzzer_sys::fuzz_target;
+use std::path::Path;
+
+fuzz_target!(|bytes: &[u8]| {
+    let form = sim::form::reference();
+    let regions = dressform::fitting::regions_of(&form);
+    if let Ok(profiles) = Profiles::parse(bytes, Path::new("fuzz.json"), &regions) {
+        let _ = dressform::fitting::fit(&profiles, &form);
+    }
+});
