@@ -66,7 +66,7 @@ fn glb_for_cad_and_the_set_replaced_as_a_whole() {
     let (code, _, stderr) = symmetrize(&[scan, "-o", out_s, "--scan-frame", "--up", "y"]);
     assert_eq!(code, 2, "{stderr}");
     // A failed command leaves the set as it was.
-    assert_eq!(outputs(&out).len(), 3);
+    assert_eq!(outputs(&out).len(), 5);
     assert!(out.join("mannequin.glb").is_file());
 
     // PLY in centimetres, Z up: read back with its header.
