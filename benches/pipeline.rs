@@ -1,5 +1,6 @@
 //! Benchmarks of the scan side on the realistic MakeHuman body, subdivided to scanner
-//! density: slicing alone, the full `symmetrize`, and the whole `dressform slice` process.
+//! density: slicing alone, the full `symmetrize` (alone, and with the pictures it writes:
+//! `preview.png` and `sections.svg`), and the whole `dressform slice` process.
 //!
 //! `cargo bench --bench pipeline`; needs `../shared/makehuman` (or `$DRESSFORM_MAKEHUMAN`).
 
@@ -7,6 +8,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use dressform::mannequin::MannequinOptions;
 use dressform::mesh::Mesh;
 use dressform::pipeline::symmetrize;
+use dressform::preview::{preview_png, sections_svg};
 use dressform::scan::format::Format;
 use dressform::scan::{self, frame::FrameOptions};
 use dressform::slice::sections;
@@ -79,6 +81,20 @@ fn benches(c: &mut Criterion) {
     group.bench_function(format!("symmetrize {} triangles", dense.body.triangles.len()), |b| {
         b.iter(|| symmetrize(&dense, &MannequinOptions::default(), |_| {}).expect("symmetrize"))
     });
+    // What `dressform symmetrize` computes: the mannequin and both pictures (target: < 1 s).
+    group.bench_function(
+        format!(
+            "symmetrize {} triangles with preview.png and sections.svg",
+            dense.body.triangles.len()
+        ),
+        |b| {
+            b.iter(|| {
+                let result =
+                    symmetrize(&dense, &MannequinOptions::default(), |_| {}).expect("symmetrize");
+                (preview_png(&dense.body, &result), sections_svg(&dense.body, &result))
+            })
+        },
+    );
 
     // The whole process on a binary PLY of about a million triangles, in the file's units.
     let million = subdivide(&base.body, 6).map_positions(|p| base.frame.to_scan(p));

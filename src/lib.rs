@@ -12,6 +12,7 @@
 //! - [`mannequin`]: the symmetric mannequin: layers, symmetry, watertight rebuild;
 //! - [`measure`]: height, crotch height, chest/waist/hip girths; Table 1 and Fig. 11;
 //! - [`pipeline`]: scan to mannequin in one call; [`profiles`]: the `profiles.json` format;
+//! - [`preview`]: pictures of a result: `preview.png` and `sections.svg`;
 //! - [`report`]: what `dressform info` says about a scan;
 //! - [`output`]: atomic file writes and all-or-nothing output sets;
 //! - [`messages`]: how problems are worded (one bounded line each);
@@ -31,6 +32,7 @@ pub mod mesh;
 pub mod messages;
 pub mod output;
 pub mod pipeline;
+pub mod preview;
 pub mod profiles;
 pub mod regions;
 pub mod report;

@@ -8,9 +8,15 @@ fn demo_runs_end_to_end_and_writes_its_outputs() {
     let dir = out.path().join("demo");
     let (code, stdout, stderr) = common::dressform(&["demo", "--out", dir.to_str().unwrap()]);
     assert_eq!(code, 0, "{stderr}");
-    for name in
-        ["scan.ply", "mannequin.obj", "profiles.json", "measurements.json", "setpoints.json"]
-    {
+    for name in [
+        "scan.ply",
+        "mannequin.obj",
+        "profiles.json",
+        "measurements.json",
+        "setpoints.json",
+        "preview.png",
+        "sections.svg",
+    ] {
         assert!(dir.join(name).is_file(), "{name} missing");
     }
     assert!(stdout.contains("every actuator reached its set-point"), "{stdout}");

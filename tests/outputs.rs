@@ -44,7 +44,7 @@ fn glb_for_cad_and_the_set_replaced_as_a_whole() {
     let names: Vec<String> = outputs(&out).into_iter().map(|(n, _)| n).collect();
     assert_eq!(
         names,
-        ["mannequin.glb", "measurements.json", "profiles.json"],
+        ["mannequin.glb", "measurements.json", "preview.png", "profiles.json", "sections.svg"],
         "no mannequin.obj left"
     );
     let glb = dressform::scan::read_mesh_file(&out.join("mannequin.glb")).unwrap().0;
@@ -66,7 +66,7 @@ fn glb_for_cad_and_the_set_replaced_as_a_whole() {
     let (code, _, stderr) = symmetrize(&[scan, "-o", out_s, "--scan-frame", "--up", "y"]);
     assert_eq!(code, 2, "{stderr}");
     // A failed command leaves the set as it was.
-    assert_eq!(outputs(&out).len(), 3);
+    assert_eq!(outputs(&out).len(), 5);
     assert!(out.join("mannequin.glb").is_file());
 
     // PLY in centimetres, Z up: read back with its header.
@@ -97,7 +97,7 @@ fn the_same_input_gives_the_same_bytes() {
             outputs(&out)
         })
         .collect();
-    assert_eq!(runs[0].len(), 3);
+    assert_eq!(runs[0].len(), 5, "mannequin, profiles, measurements and the two pictures");
     for run in &runs[1..] {
         for ((name, a), (_, b)) in runs[0].iter().zip(run) {
             assert!(a == b, "{name} differs between runs");

@@ -4,21 +4,13 @@
 
 use crate::common;
 
-use common::largest_mirror_gap;
+use common::{largest_mirror_gap, surface_mesh as mesh_of};
 use dressform::mannequin::MannequinOptions;
-use dressform::mesh::{Mesh, topology};
+use dressform::mesh::topology;
 use dressform::pipeline::symmetrize;
 use dressform::scan::{self, frame::FrameOptions};
-use glam::DVec3;
-use sim::capture::{Artifacts, BodyParams, Pose, TriangleSurface, capture, generate};
+use sim::capture::{Artifacts, BodyParams, Pose, capture, generate};
 use std::path::Path;
-
-fn mesh_of(surface: &TriangleSurface) -> Mesh {
-    Mesh::new(
-        surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
-        surface.triangles.clone(),
-    )
-}
 
 #[test]
 fn an_asymmetric_body_becomes_a_mirror_symmetric_mannequin_with_its_girths() {

@@ -94,7 +94,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
     }
     outln!();
     outln!(
-        "Written to {}: scan.ply, mannequin.obj, profiles.json, measurements.json, setpoints.json",
+        "Written to {}: scan.ply, mannequin.obj, profiles.json, measurements.json, setpoints.json, preview.png (a picture of the scan and the mannequin), sections.svg",
         args.out.display()
     );
     shape_verdict(&shape)

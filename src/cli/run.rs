@@ -14,6 +14,7 @@ use dressform::mannequin::MannequinOptions;
 use dressform::mesh::topology;
 use dressform::output::OutputSet;
 use dressform::pipeline::{STEPS, Symmetrized, symmetrize};
+use dressform::preview::{preview_png, sections_svg};
 use dressform::profiles::Profiles;
 use dressform::regions::Region;
 use dressform::scan::{self, Scan, format::Export, format::Format};
@@ -34,7 +35,8 @@ pub struct RunArgs {
     sim: SimArgs,
     #[command(flatten)]
     shape: ShapeArgs,
-    /// Where to write mannequin.obj, profiles.json, measurements.json and setpoints.json.
+    /// Where to write mannequin.obj, profiles.json, measurements.json, setpoints.json,
+    /// preview.png and sections.svg.
     #[arg(long, default_value = "dressform-run")]
     out: PathBuf,
     #[command(flatten)]
@@ -93,7 +95,7 @@ pub fn shape_form(
     let profiles = Profiles::of(&result.mannequin, &result.comparison.levels);
     let fitted = fit(&profiles, form).map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
     let setpoints = setpoints_of(&fitted);
-    write_outputs(out, outputs, &result, &profiles, &setpoints)?;
+    write_outputs(out, scan, outputs, &result, &profiles, &setpoints)?;
     bar.finish_and_clear();
 
     outln!("Symmetric mannequin and set-points written to {}.", out.display());
@@ -125,6 +127,7 @@ pub fn shape_form(
 
 fn write_outputs(
     out: &Path,
+    scan: &Scan,
     mut outputs: OutputSet,
     result: &Symmetrized,
     profiles: &Profiles,
@@ -139,6 +142,8 @@ fn write_outputs(
     let measurements = serde_json::to_vec_pretty(&result.comparison).map_err(Failure::other)?;
     outputs.add("measurements.json", measurements);
     outputs.add("setpoints.json", setpoints.to_json_string());
+    outputs.add("preview.png", preview_png(&scan.body, result));
+    outputs.add("sections.svg", sections_svg(&scan.body, result));
     outputs.commit(out).map_err(Failure::other)
 }
 

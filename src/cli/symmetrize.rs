@@ -8,6 +8,7 @@ use dressform::measure::Comparison;
 use dressform::mesh::topology;
 use dressform::output::OutputSet;
 use dressform::pipeline::{STEPS, symmetrize};
+use dressform::preview::{preview_png, sections_svg};
 use dressform::profiles::Profiles;
 use dressform::scan;
 use dressform::symmetry::Preserve;
@@ -18,7 +19,7 @@ pub struct SymmetrizeArgs {
     /// The scan: an .obj, .ply or .stl file.
     scan: PathBuf,
     /// Output directory (created if missing): mannequin.obj (or .ply, .stl, .glb),
-    /// profiles.json, measurements.json, replaced as a whole.
+    /// profiles.json, measurements.json, preview.png, sections.svg, replaced as a whole.
     #[arg(short, long)]
     out: PathBuf,
     /// Torso layers.
@@ -78,6 +79,8 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     let profiles = Profiles::of(&result.mannequin, &result.comparison.levels);
     outputs.add("profiles.json", pretty_json(&profiles)?);
     outputs.add("measurements.json", measurements.clone());
+    outputs.add("preview.png", preview_png(&scan.body, &result));
+    outputs.add("sections.svg", sections_svg(&scan.body, &result));
     outputs.commit(&args.out).map_err(Failure::other)?;
     bar.finish_and_clear();
     if args.json {

@@ -3,12 +3,15 @@
 //!
 //! Layers (defaults from the paper): 100 torso layers from just above the crotch to the neck,
 //! 50 leg layers from the ankles to just below the crotch. Above the armpits the torso sections
-//! are cut off at the armholes ([`crate::regions::Armhole`], as a dress form's arm plates), so the arms are not part
-//! of the torso. All layers share one symmetry plane, x = `axis`: the median of the torso
-//! sections' bounding-box centres.
+//! are cut at the armholes ([`crate::regions::Armhole`]), so the arms are not part of the
+//! torso: the cut edges of the layers stack into flat arm plates, and above the shoulder points
+//! the layers follow the shoulders with their slope, eased where the body's shoulder top is
+//! nearly level ([`shoulders`]). All layers share one symmetry plane, x = `axis`: the median of
+//! the torso sections' bounding-box centres.
 
 mod layers;
 mod rebuild;
+mod shoulders;
 
 use crate::mesh::Mesh;
 use crate::regions::{BodyRegions, Landmarks, Region, RegionError};
@@ -123,9 +126,15 @@ pub fn build(
         });
     }
     crate::symmetry::check_rays(options.rays)?;
-    let layers::SymmetricLayers { axis, torso, left_leg, right_leg } =
+    let layers::SymmetricLayers { axis, mut torso, left_leg, right_leg } =
         layers::symmetric_layers(body, regions, keep, options)?;
-    let mesh = rebuild::rebuild(&torso, &left_leg, &right_leg, axis);
+    let lm = &regions.landmarks;
+    shoulders::ease(
+        &mut torso,
+        axis,
+        lm.left_armhole.shoulder_point.z.min(lm.right_armhole.shoulder_point.z),
+    );
+    let mesh = rebuild::rebuild(&torso, &left_leg, &right_leg, axis, regions.landmarks.crotch);
     Ok(Mannequin {
         axis,
         landmarks: regions.landmarks,

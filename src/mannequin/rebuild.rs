@@ -1,19 +1,46 @@
-//! Rebuilding a watertight mesh from the symmetric rings.
+//! Rebuilding a watertight mesh from the symmetric rings (paper Fig. 10).
 //!
-//! - Neighbouring rings are stitched into a band of triangles ([`stitch`]); rings of equal
-//!   size give a strip of quads.
-//! - Each torso ring also gets a vertex on the symmetry plane at the front and at the back
-//!   (the midpoint of the edge that crosses it: no change of shape), where the crotch seam
-//!   starts and ends.
-//! - The crotch: the lowest torso ring is split at the plane into its left and right halves; a
-//!   seam runs along the plane from front to back, between the legs. The left leg's top ring is
-//!   stitched to "left half + seam", the right leg's to "seam + right half"; the seam's edges
-//!   are shared by the two, so the surface stays closed and manifold.
-//! - Caps (a fan around the ring's centre) close the neck and the two ankles.
+//! - **Bands**: two neighbouring rings are stitched by one rule ([`stitch`]): each vertex
+//!   carries a parameter that runs once around its ring from 0 to 1, both rings starting at
+//!   corresponding points, and the band's triangles follow the two rings' vertices in order of
+//!   that parameter. Between layers the parameter is the ray index, so ray `i` of one layer
+//!   faces ray `i` of the next (a strip of quads, each split along its shorter diagonal).
+//! - **Torso rings** also get a vertex on the symmetry plane at the front and at the back (the
+//!   midpoint of the edge that crosses it: no change of shape).
+//! - **The crotch** ([`crotch`]): the lowest torso ring sits just above the crotch. A seam
+//!   runs on the symmetry plane at the crotch height from that ring's front midline vertex to
+//!   its back one. Each leg's top ring is stitched to its half of the lowest torso ring closed
+//!   by the seam: the two curves are matched piece by piece between anchors (the front and back
+//!   ends of the seam and the leg ring's vertices nearest to them), by arc length within each
+//!   piece, so the outside of the thigh meets the side of the hip and the inside of the thigh
+//!   meets the seam. Both legs share the seam's edges: one surface, closed and manifold, with
+//!   its lowest point on the symmetry plane at the crotch height.
+//! - **Caps** (a fan around the ring's centre, flat) close the neck and the two ankles.
 
 use super::Layer;
 use crate::mesh::Mesh;
 use glam::{DVec2, DVec3};
+
+/// A ring of mesh vertices, closed, counter-clockwise from above, with each vertex's
+/// parameter in `[0, 1)` (the first vertex at 0; see the module documentation).
+struct Ring {
+    vertices: Vec<u32>,
+    params: Vec<f64>,
+}
+
+impl Ring {
+    /// A ring whose vertices are evenly spaced in parameter (the layers' rays).
+    fn evenly(vertices: Vec<u32>) -> Ring {
+        let n = vertices.len() as f64;
+        let params = (0..vertices.len()).map(|k| k as f64 / n).collect();
+        Ring { vertices, params }
+    }
+
+    /// Parameter of vertex `k`, with `k == len` standing for the first vertex come round again.
+    fn param(&self, k: usize) -> f64 {
+        if k == self.vertices.len() { 1.0 } else { self.params[k] }
+    }
+}
 
 /// Adds the points of a ring at height `z`; returns their vertex indices.
 fn add_ring(mesh: &mut Mesh, points: &[DVec2], z: f64) -> Vec<u32> {
@@ -22,19 +49,26 @@ fn add_ring(mesh: &mut Mesh, points: &[DVec2], z: f64) -> Vec<u32> {
     (first..mesh.positions.len() as u32).collect()
 }
 
-/// Stitches closed ring `lower` to closed ring `upper` (both counter-clockwise from above,
-/// starting near the front), choosing at each step the shorter diagonal. Makes
+/// Parameters below this difference are equal: the band has a quad there.
+const SAME_PARAM: f64 = 1e-12;
+
+/// Stitches ring `lower` to ring `upper` (see the module documentation). Makes
 /// `lower.len() + upper.len()` outward-facing triangles.
-fn stitch(mesh: &mut Mesh, lower: &[u32], upper: &[u32]) {
-    let (na, nb) = (lower.len(), upper.len());
+fn stitch(mesh: &mut Mesh, lower: &Ring, upper: &Ring) {
+    let (na, nb) = (lower.vertices.len(), upper.vertices.len());
     let p = |i: u32| mesh.positions[i as usize];
     let (mut i, mut j) = (0, 0);
     let mut triangles = Vec::with_capacity(na + nb);
     while i < na || j < nb {
-        let (a, a_next) = (lower[i % na], lower[(i + 1) % na]);
-        let (b, b_next) = (upper[j % nb], upper[(j + 1) % nb]);
-        let advance_lower =
-            j == nb || (i < na && p(a_next).distance(p(b)) < p(a).distance(p(b_next)));
+        let (a, a_next) = (lower.vertices[i % na], lower.vertices[(i + 1) % na]);
+        let (b, b_next) = (upper.vertices[j % nb], upper.vertices[(j + 1) % nb]);
+        let advance_lower = j == nb
+            || (i < na && {
+                let (pa, pb) = (lower.param(i + 1), upper.param(j + 1));
+                pa < pb - SAME_PARAM
+                    || (pa <= pb + SAME_PARAM
+                        && p(a_next).distance(p(b)) < p(a).distance(p(b_next)))
+            });
         if advance_lower {
             triangles.push([a, a_next, b]);
             i += 1;
@@ -59,6 +93,7 @@ fn cap(mesh: &mut Mesh, ring: &[u32], centre: DVec3, up: bool) {
 
 /// A torso ring with its front and back vertices on the symmetry plane inserted: the front
 /// one first, then the left half (front to back), the back one, the right half (back to front).
+/// Returns the ring and the index of the back vertex.
 fn with_midline(points: &[DVec2]) -> (Vec<DVec2>, usize) {
     let n = points.len(); // rays - 2
     let half = n / 2; // points per side
@@ -72,16 +107,126 @@ fn with_midline(points: &[DVec2]) -> (Vec<DVec2>, usize) {
     (out, half + 1)
 }
 
-/// The mannequin mesh from its layers (each list bottom to top) and symmetry plane.
-pub(super) fn rebuild(torso: &[Layer], left: &[Layer], right: &[Layer], axis: f64) -> Mesh {
+/// Cumulative arc length around the closed ring `points`: `len + 1` values from 0 to the
+/// perimeter.
+fn arc_lengths(points: &[DVec2]) -> Vec<f64> {
+    let n = points.len();
+    let mut s = Vec::with_capacity(n + 1);
+    s.push(0.0);
+    for k in 0..n {
+        s.push(s[k] + points[k].distance(points[(k + 1) % n]));
+    }
+    s
+}
+
+/// Parameters for a closed ring of `points` matched piecewise to another: vertex 0 and
+/// vertex `anchor` (`0..=len`; `len` is vertex 0 come round again) are the two anchors, the
+/// first piece (0 to `anchor`) takes `[0, 1/2)` and the second `[1/2, 1)`, each by arc length.
+fn anchored_params(points: &[DVec2], anchor: usize) -> Vec<f64> {
+    let (n, s) = (points.len(), arc_lengths(points));
+    let piece = |from: usize, to: usize, k: usize| {
+        let length = s[to] - s[from];
+        if length > 0.0 { (s[k] - s[from]) / length } else { 0.0 }
+    };
+    (0..n)
+        .map(|k| match k {
+            0 => 0.0,
+            k if k < anchor => 0.5 * piece(0, anchor, k),
+            k => 0.5 + 0.5 * piece(anchor, n, k),
+        })
+        .collect()
+}
+
+/// Index of the point of `points` nearest to `p`.
+fn nearest(points: &[DVec2], p: DVec2) -> usize {
+    (0..points.len())
+        .min_by(|&a, &b| points[a].distance_squared(p).total_cmp(&points[b].distance_squared(p)))
+        .expect("a ring has points")
+}
+
+/// Stitches a leg's top ring (`leg`, vertex indices, counter-clockwise from above) to
+/// `boundary`: its half of the lowest torso ring closed by the seam, starting at the seam's
+/// front end, with the seam's back end at index `back` (see the module documentation).
+fn join_leg(mesh: &mut Mesh, leg: &[u32], boundary: Vec<u32>, back: usize) {
+    let flat = |vs: &[u32]| -> Vec<DVec2> {
+        vs.iter().map(|&v| mesh.positions[v as usize].truncate()).collect()
+    };
+    let (leg_points, boundary_points) = (flat(leg), flat(&boundary));
+    let n = leg.len();
+    let front_anchor = nearest(&leg_points, boundary_points[0]);
+    let back_anchor = nearest(&leg_points, boundary_points[back]);
+    let rotated: Vec<u32> = (0..n).map(|k| leg[(front_anchor + k) % n]).collect();
+    let mut anchor = (back_anchor + n - front_anchor) % n;
+    if anchor == 0 {
+        // Both ends of the seam face one leg vertex: the whole leg ring faces the longer piece
+        // of the boundary (the half ring, not the seam).
+        let s = arc_lengths(&boundary_points);
+        anchor = if s[back] > s[boundary.len()] - s[back] { n } else { 0 };
+    }
+    let leg_params = anchored_params(&flat(&rotated), anchor);
+    let boundary_params = anchored_params(&boundary_points, back);
+    stitch(
+        mesh,
+        &Ring { vertices: rotated, params: leg_params },
+        &Ring { vertices: boundary, params: boundary_params },
+    );
+}
+
+/// The crotch (see the module documentation): the seam on the plane x = `axis` at height
+/// `crotch` from the front to the back vertex of the lowest torso ring `ring0` (whose back
+/// vertex is at `back`), and the two legs' top rings joined to it.
+fn crotch(
+    mesh: &mut Mesh,
+    ring0: &[u32],
+    back: usize,
+    [left_top, right_top]: [&[u32]; 2],
+    axis: f64,
+    crotch: f64,
+) {
+    let (front_p, back_p) =
+        (mesh.positions[ring0[0] as usize], mesh.positions[ring0[back] as usize]);
+    // Seam points as far apart as the ring's points.
+    let spacing = (0..back).map(|k| {
+        let (a, b) = (mesh.positions[ring0[k] as usize], mesh.positions[ring0[k + 1] as usize]);
+        a.truncate().distance(b.truncate())
+    });
+    let spacing = spacing.sum::<f64>() / back as f64;
+    let count = ((back_p.y - front_p.y) / spacing).round().max(1.0) as usize;
+    let seam: Vec<u32> = (1..count)
+        .map(|k| {
+            let y = front_p.y + (back_p.y - front_p.y) * k as f64 / count as f64;
+            mesh.positions.push(DVec3::new(axis, y, crotch));
+            (mesh.positions.len() - 1) as u32
+        })
+        .collect();
+    // Left: front, the left half, back, the seam back to front.
+    let mut left: Vec<u32> = ring0[..=back].to_vec();
+    left.extend(seam.iter().rev());
+    // Right: front, the seam front to back, back, the right half.
+    let mut right: Vec<u32> = vec![ring0[0]];
+    right.extend(&seam);
+    right.extend(&ring0[back..]);
+    join_leg(mesh, left_top, left, back);
+    join_leg(mesh, right_top, right, seam.len() + 1);
+}
+
+/// The mannequin mesh from its layers (each list bottom to top), its symmetry plane and the
+/// crotch height.
+pub(super) fn rebuild(
+    torso: &[Layer],
+    left: &[Layer],
+    right: &[Layer],
+    axis: f64,
+    crotch_z: f64,
+) -> Mesh {
     let mut mesh = Mesh::default();
 
     let mut torso_rings = Vec::with_capacity(torso.len());
-    let mut back_index = 0;
+    let mut back = 0;
     for layer in torso {
-        let (points, back) = with_midline(&layer.points);
-        back_index = back;
-        torso_rings.push(add_ring(&mut mesh, &points, layer.z));
+        let (points, b) = with_midline(&layer.points);
+        back = b;
+        torso_rings.push(Ring::evenly(add_ring(&mut mesh, &points, layer.z)));
     }
     for pair in torso_rings.windows(2) {
         stitch(&mut mesh, &pair[0], &pair[1]);
@@ -89,43 +234,27 @@ pub(super) fn rebuild(torso: &[Layer], left: &[Layer], right: &[Layer], axis: f6
     let top = torso.last().expect("at least two torso layers");
     cap(
         &mut mesh,
-        torso_rings.last().expect("rings"),
+        &torso_rings.last().expect("rings").vertices,
         DVec3::new(axis, top.centre[1], top.z),
         true,
     );
 
     let mut leg_tops = Vec::with_capacity(2);
     for leg in [left, right] {
-        let rings: Vec<Vec<u32>> =
-            leg.iter().map(|l| add_ring(&mut mesh, &l.points, l.z)).collect();
+        let rings: Vec<Ring> =
+            leg.iter().map(|l| Ring::evenly(add_ring(&mut mesh, &l.points, l.z))).collect();
         for pair in rings.windows(2) {
             stitch(&mut mesh, &pair[0], &pair[1]);
         }
         let bottom = &leg[0];
-        cap(&mut mesh, &rings[0], DVec3::new(bottom.centre[0], bottom.centre[1], bottom.z), false);
-        leg_tops.push(rings.last().expect("at least two leg layers").clone());
+        cap(
+            &mut mesh,
+            &rings[0].vertices,
+            DVec3::new(bottom.centre[0], bottom.centre[1], bottom.z),
+            false,
+        );
+        leg_tops.push(rings.last().expect("at least two leg layers").vertices.clone());
     }
-
-    // The crotch seam, on the symmetry plane, halfway between the torso and the leg tops.
-    let ring0 = &torso_rings[0];
-    let (front, back) =
-        (mesh.positions[ring0[0] as usize], mesh.positions[ring0[back_index] as usize]);
-    let seam_z = 0.5 * (torso[0].z + left.last().expect("legs").z);
-    let seam_points = (ring0.len() / 8).max(1);
-    let seam: Vec<u32> = (1..=seam_points)
-        .map(|k| {
-            let t = k as f64 / (seam_points + 1) as f64;
-            let p = front.lerp(back, t);
-            mesh.positions.push(DVec3::new(axis, p.y, seam_z));
-            (mesh.positions.len() - 1) as u32
-        })
-        .collect();
-    let mut left_boundary: Vec<u32> = ring0[..=back_index].to_vec();
-    left_boundary.extend(seam.iter().rev());
-    let mut right_boundary: Vec<u32> = vec![ring0[0]];
-    right_boundary.extend(&seam);
-    right_boundary.extend(&ring0[back_index..]);
-    stitch(&mut mesh, &leg_tops[0], &left_boundary);
-    stitch(&mut mesh, &leg_tops[1], &right_boundary);
+    crotch(&mut mesh, &torso_rings[0].vertices, back, [&leg_tops[0], &leg_tops[1]], axis, crotch_z);
     mesh
 }

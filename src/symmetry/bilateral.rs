@@ -16,7 +16,10 @@ pub struct LegRing {
 /// Makes the left and right leg sections at one height mirror images of each other about the
 /// plane x = `axis`, with `n` rays:
 /// - eq. 9: each leg's centre is its bounding-box centre; the new centres are mirror images
-///   (mean distance from the plane, mean depth);
+///   (mean distance from the plane, mean depth). Over all heights this is the **stance rule**:
+///   each leg's centre line is its direction, and the mannequin's legs take the mean of the
+///   left leg's direction and the right leg's mirrored (a leg abducted 15 degrees and one at
+///   6 degrees give two legs at 10.5 degrees), each leg's shape carried along with its centre;
 /// - eq. 10: each leg casts `n` rays (farthest crossing);
 /// - eq. 11: left ray `i` and right ray `n - i` (mirror images) take their mean;
 /// - eq. 12: both are scaled about their centres to the mean of the two original girths (the

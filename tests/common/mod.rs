@@ -3,6 +3,8 @@
 
 use std::path::PathBuf;
 
+pub mod quality;
+
 /// Whether the environment variable `var` is set to `1` (CI sets `DRESSFORM_REQUIRE_SHARED` and
 /// `DRESSFORM_REQUIRE_PEERS`).
 fn required(var: &str) -> bool {
@@ -199,8 +201,13 @@ pub fn synthetic_scan(dir: &std::path::Path, seed: u64) -> PathBuf {
 
 /// A generated customer's surface as a mesh (in the canonical frame, as the generator makes it).
 pub fn mesh_of(body: &sim::capture::SyntheticBody) -> Mesh {
+    surface_mesh(&body.surface)
+}
+
+/// A triangle surface of `sim` (a generated body's, or a simulated scan) as a mesh.
+pub fn surface_mesh(surface: &sim::capture::TriangleSurface) -> Mesh {
     Mesh::new(
-        body.surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
-        body.surface.triangles.clone(),
+        surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
+        surface.triangles.clone(),
     )
 }
