@@ -22,6 +22,7 @@ mod makehuman;
 mod mannequin;
 mod measurements;
 mod outputs;
+mod pose_symmetry;
 mod run_end_to_end;
 mod segmentation;
 mod segmentation_stances;
