@@ -104,13 +104,13 @@ fn arm_and_leg_abduction_are_recovered_from_makehuman_scans() {
         let body = mh.shaped(&targets).unwrap();
         // One arm 10-20 degrees further out with its shoulder raised, the other side's leg out.
         let (arm, leg, out) = if case % 2 == 0 { (".L", ".R", -1.0) } else { (".R", ".L", 1.0) };
-        let arm_deg = rng.random_range(10.0..20.0);
-        let leg_deg = rng.random_range(3.0..8.0);
-        let shoulder_deg = rng.random_range(3.0..8.0);
+        let arm_deg: f64 = rng.random_range(10.0..20.0);
+        let leg_deg: f64 = rng.random_range(3.0..8.0);
+        let shoulder_deg: f64 = rng.random_range(3.0..8.0);
         let pose = Pose::rest()
-            .rotate(&format!("upperarm01{arm}"), DVec3::Y * (out * arm_deg as f64).to_radians())
-            .rotate(&format!("clavicle{arm}"), DVec3::Y * (out * shoulder_deg as f64).to_radians())
-            .rotate(&format!("upperleg01{leg}"), DVec3::Y * (-out * leg_deg as f64).to_radians());
+            .rotate(&format!("upperarm01{arm}"), DVec3::Y * (out * arm_deg).to_radians())
+            .rotate(&format!("clavicle{arm}"), DVec3::Y * (out * shoulder_deg).to_radians())
+            .rotate(&format!("upperleg01{leg}"), DVec3::Y * (-out * leg_deg).to_radians());
         let posed = mh.pose(&body, &pose).unwrap();
         let (points, normals) = scan_of(&mh.base.skin(&posed), &mut rng);
         let truth = mh.rig.bone_heads(&posed);

@@ -51,7 +51,7 @@ pub fn iterate(
     active: &[bool],
     lambda: f64,
 ) -> Step {
-    let n = prep.layout.len();
+    let n = prep.layout.size();
     let (mut h, mut g) = normal_equations(prep, data, posed);
     // Priors: beta (residual sqrt(c) beta) and the bones' angles (residual sqrt(c) theta_k,
     // d theta_k / d w_k = A_parent^T, so J^T J = c I and J^T r = c A_parent theta_k).
@@ -62,7 +62,7 @@ pub fn iterate(
     }
     let parents = &prep.model.skeleton.parents;
     for (b, theta) in params.theta.iter().enumerate().skip(1) {
-        let above = parents[b].map_or(glam::DMat3::IDENTITY, |p| posed.g[p].matrix3.into());
+        let above = parents[b].map_or(glam::DMat3::IDENTITY, |p| posed.g[p].matrix3);
         let pull = above * *theta * POSE_PRIOR_MM2_PER_RAD2;
         let at = prep.layout.bone(b);
         for d in 0..3 {
@@ -104,7 +104,7 @@ fn normal_equations(
     data: &Quadratics,
     posed: &Posed,
 ) -> (DMatrix<f64>, DVector<f64>) {
-    let n = prep.layout.len();
+    let n = prep.layout.size();
     data.terms
         .par_iter()
         .fold(

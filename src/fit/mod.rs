@@ -216,7 +216,7 @@ pub fn fit(
 fn active(prep: &Prepared, bones: Bones) -> Vec<bool> {
     let layout = prep.layout;
     let names = &prep.model.skeleton.names;
-    let mut on = vec![false; layout.len()];
+    let mut on = vec![false; layout.size()];
     on[..3].iter_mut().for_each(|a| *a = true);
     for (b, name) in names.iter().enumerate() {
         let free = b == 0

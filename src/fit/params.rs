@@ -30,7 +30,7 @@ pub struct Layout {
 
 impl Layout {
     /// The number of parameters.
-    pub fn len(&self) -> usize {
+    pub fn size(&self) -> usize {
         3 + 3 * self.bones + self.k
     }
     /// The first index of bone `b`'s rotation increment.
@@ -103,12 +103,15 @@ impl<'m> Prepared<'m> {
         // (t_l = translation + sum_m (A_parent(m) - A_m) j_m; A the rotation parts).
         let mut joint_shift = vec![vec![DVec3::ZERO; self.layout.k]; g.len()];
         for l in 0..g.len() {
-            let above = parents[l].map_or(DMat3::IDENTITY, |p| g[p].matrix3.into());
-            let own: DMat3 = g[l].matrix3.into();
-            for k in 0..self.layout.k {
-                let here = (above - own) * self.joint_directions[k][l];
-                joint_shift[l][k] = parents[l].map_or(here, |p| joint_shift[p][k] + here);
-            }
+            let above = parents[l].map_or(DMat3::IDENTITY, |p| g[p].matrix3);
+            let own = g[l].matrix3;
+            let shift = (self.joint_directions.iter().enumerate())
+                .map(|(k, dj)| {
+                    let here = (above - own) * dj[l];
+                    parents[l].map_or(here, |p| joint_shift[p][k] + here)
+                })
+                .collect();
+            joint_shift[l] = shift;
         }
         Posed { rest, g, vertices, pivots, joint_shift }
     }
@@ -189,7 +192,7 @@ impl Params {
             if dw == DVec3::ZERO {
                 continue;
             }
-            let above: DMat3 = parents[b].map_or(DMat3::IDENTITY, |p| posed.g[p].matrix3.into());
+            let above: DMat3 = parents[b].map_or(DMat3::IDENTITY, |p| posed.g[p].matrix3);
             let local = above.transpose() * dw;
             *theta = (DQuat::from_scaled_axis(local) * DQuat::from_scaled_axis(*theta))
                 .normalize()
