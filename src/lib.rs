@@ -8,6 +8,7 @@
 //! - [`slice`]: horizontal cross-sections and their girths;
 //! - [`regions`]: body regions and landmarks (crotch, armpits, neck) from tracked slices;
 //! - [`symmetry`]: axial (torso) and bilateral (legs) symmetry of sections, girth preserved;
+//! - [`fit`]: the body model fitted to a scan (eq. 4): pose and shape, robust ICP with LM;
 //! - [`fitting`]: the robotic form's rings placed on the mannequin, set-points, fidelity;
 //! - [`mannequin`]: the symmetric mannequin: layers, symmetry, watertight rebuild;
 //! - [`measure`]: height, crotch height, chest/waist/hip girths; Table 1 and Fig. 11;
@@ -23,6 +24,7 @@
 
 pub mod body_model;
 pub mod controller;
+pub mod fit;
 pub mod fitting;
 pub mod input;
 pub mod makehuman;

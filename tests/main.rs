@@ -23,6 +23,7 @@ mod mannequin;
 mod mannequin_quality;
 mod measurements;
 mod outputs;
+mod pose_symmetry;
 mod preview;
 mod run_end_to_end;
 mod segmentation;

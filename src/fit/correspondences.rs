@@ -1,0 +1,136 @@
+//! Closest-point pairs both ways between the posed model and the scan (eq. 4's data term):
+//! model vertices to their nearest scan points, and sampled scan points to their nearest model
+//! vertices, each pair rejected when the two normals disagree, each weighted robustly
+//! ([`super::robust`]). Nearest neighbours by `kiddo` k-d trees.
+
+use super::robust;
+use glam::{DMat3, DVec3};
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rayon::prelude::*;
+
+/// Pairs whose normals are more than 60 degrees apart are rejected (a front surface matched to
+/// a back one, an arm to the torso beside it): the usual threshold of robust ICP.
+pub const MIN_NORMAL_COS: f64 = 0.5;
+
+/// The weight of point-to-point beside point-to-plane distances: "a little point-to-point"
+/// keeps points from sliding along flat surfaces without slowing convergence (1/10 is the
+/// common choice in registration).
+pub const POINT_TO_POINT: f64 = 0.1;
+
+/// The scan: points and unit normals, with a k-d tree over the points.
+pub struct ScanCloud<'a> {
+    /// The points (mm, canonical frame).
+    pub points: &'a [DVec3],
+    /// Their unit outward normals.
+    pub normals: &'a [DVec3],
+    tree: ImmutableKdTree<f64, 3>,
+    /// The scan points used for scan-to-model pairs.
+    samples: Vec<usize>,
+}
+
+impl<'a> ScanCloud<'a> {
+    /// Indexes `points` and picks every `stride`-th one as a sample for scan-to-model pairs.
+    pub fn new(points: &'a [DVec3], normals: &'a [DVec3], stride: usize) -> Self {
+        let coords: Vec<[f64; 3]> = points.iter().map(|p| p.to_array()).collect();
+        let tree = ImmutableKdTree::new_from_slice(&coords);
+        let samples = (0..points.len()).step_by(stride.max(1)).collect();
+        ScanCloud { points, normals, tree, samples }
+    }
+}
+
+/// The data term for the current correspondences, gathered per model vertex: the cost of
+/// vertex `v` at position `x` is `x^T A x - 2 c.x + e` (the weighted sum of its pairs'
+/// point-to-plane and point-to-point squared distances), divided by the pair count.
+pub struct Quadratics {
+    /// `(vertex, A, c, e)` for each vertex with pairs.
+    pub terms: Vec<(usize, DMat3, DVec3, f64)>,
+    /// The pairs found in each direction (model to scan, scan to model) before weighting.
+    pub pairs: [usize; 2],
+    /// The root mean square of the point-to-plane distances of the pairs, per direction (mm).
+    pub rms_mm: [f64; 2],
+}
+
+impl Quadratics {
+    /// The data cost of posed vertices `x`.
+    pub fn cost(&self, x: &[DVec3]) -> f64 {
+        self.terms.iter().map(|(v, a, c, e)| x[*v].dot(*a * x[*v]) - 2.0 * c.dot(x[*v]) + e).sum()
+    }
+}
+
+/// One pair: model vertex, scan point, the normal of its plane, its robust weight.
+struct Pair {
+    vertex: usize,
+    target: DVec3,
+    normal: DVec3,
+    weight: f64,
+    plane_mm: f64,
+}
+
+/// The pairs both ways between the posed model (`vertices` with `normals`) and the scan, robust
+/// weights at scale `sigma` (mm), gathered per vertex.
+pub fn gather(scan: &ScanCloud, vertices: &[DVec3], normals: &[DVec3], sigma: f64) -> Quadratics {
+    let weigh = |vertex: usize, target: DVec3, normal: DVec3| {
+        let d = vertices[vertex] - target;
+        let plane = normal.dot(d);
+        let r2 = plane * plane + POINT_TO_POINT * d.length_squared();
+        Pair {
+            vertex,
+            target,
+            normal,
+            weight: robust::geman_mcclure(r2.sqrt(), sigma),
+            plane_mm: plane,
+        }
+    };
+    let to_scan: Vec<Pair> = (0..vertices.len())
+        .into_par_iter()
+        .filter_map(|v| {
+            let hit = scan.tree.nearest_one::<SquaredEuclidean>(&vertices[v].to_array());
+            let s = hit.item as usize;
+            (normals[v].dot(scan.normals[s]) >= MIN_NORMAL_COS)
+                .then(|| weigh(v, scan.points[s], scan.normals[s]))
+        })
+        .collect();
+    let coords: Vec<[f64; 3]> = vertices.iter().map(|p| p.to_array()).collect();
+    let model_tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&coords);
+    let to_model: Vec<Pair> = scan
+        .samples
+        .par_iter()
+        .filter_map(|&s| {
+            let hit = model_tree.nearest_one::<SquaredEuclidean>(&scan.points[s].to_array());
+            let v = hit.item as usize;
+            (normals[v].dot(scan.normals[s]) >= MIN_NORMAL_COS)
+                .then(|| weigh(v, scan.points[s], normals[v]))
+        })
+        .collect();
+    let rms = |p: &[Pair]| {
+        (p.iter().map(|p| p.plane_mm * p.plane_mm).sum::<f64>() / p.len().max(1) as f64).sqrt()
+    };
+    let mut per_vertex: Vec<Option<(DMat3, DVec3, f64)>> = vec![None; vertices.len()];
+    for (set, count) in [(&to_scan, to_scan.len()), (&to_model, to_model.len())] {
+        // Each direction counts as the mean over its pairs, the two equally.
+        let share = 0.5 / count.max(1) as f64;
+        for p in set.iter() {
+            let m = (DMat3::from_cols(
+                p.normal * p.normal.x,
+                p.normal * p.normal.y,
+                p.normal * p.normal.z,
+            ) + DMat3::IDENTITY * POINT_TO_POINT)
+                * (p.weight * share);
+            let ms = m * p.target;
+            let entry = per_vertex[p.vertex].get_or_insert((DMat3::ZERO, DVec3::ZERO, 0.0));
+            entry.0 += m;
+            entry.1 += ms;
+            entry.2 += p.target.dot(ms);
+        }
+    }
+    let terms = per_vertex
+        .into_iter()
+        .enumerate()
+        .filter_map(|(v, t)| t.map(|(a, c, e)| (v, a, c, e)))
+        .collect();
+    Quadratics {
+        terms,
+        pairs: [to_scan.len(), to_model.len()],
+        rms_mm: [rms(&to_scan), rms(&to_model)],
+    }
+}

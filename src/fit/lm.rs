@@ -1,0 +1,130 @@
+//! One damped Gauss-Newton (Levenberg-Marquardt) iteration of eq. 4 for fixed
+//! correspondences: the normal equations `(J^T W J + priors) dx = -J^T W r`, accumulated over
+//! the model's vertices in parallel (rayon), solved for the active parameters with damping
+//! `lambda diag(H)`; the damping grows until the step lowers the energy.
+
+use super::correspondences::Quadratics;
+use super::params::{Params, Posed, Prepared};
+use super::priors::{BETA_PRIOR_MM2, POSE_PRIOR_MM2_PER_RAD2};
+use glam::DVec3;
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+
+/// The first damping factor (relative to the diagonal), and how it changes after a rejected or
+/// accepted step: Nielsen's classic choices, simplified.
+pub const LAMBDA_START: f64 = 1e-3;
+const LAMBDA_UP: f64 = 10.0;
+const LAMBDA_DOWN: f64 = 3.0;
+/// A step is given up when the damping exceeds this (the energy is at a minimum along every
+/// direction the linearisation sees).
+const LAMBDA_MAX: f64 = 1e8;
+
+/// The energy of eq. 4 at `params`: the data cost of the posed vertices plus the priors.
+pub fn energy(data: &Quadratics, params: &Params, posed: &Posed) -> f64 {
+    data.cost(&posed.vertices) + prior(params)
+}
+
+fn prior(params: &Params) -> f64 {
+    BETA_PRIOR_MM2 * params.beta.iter().map(|b| b * b).sum::<f64>()
+        + POSE_PRIOR_MM2_PER_RAD2
+            * params.theta.iter().skip(1).map(|t| t.length_squared()).sum::<f64>()
+}
+
+/// The result of one iteration.
+pub struct Step {
+    /// The new parameters (the old ones when no step lowered the energy).
+    pub params: Params,
+    /// The energy before and after.
+    pub before: f64,
+    /// The energy after the step.
+    pub after: f64,
+    /// The damping to start the next iteration with.
+    pub lambda: f64,
+}
+
+/// One LM iteration over the parameters marked `active`, from `params` (posed as `posed`).
+pub fn iterate(
+    prep: &Prepared,
+    data: &Quadratics,
+    params: &Params,
+    posed: &Posed,
+    active: &[bool],
+    lambda: f64,
+) -> Step {
+    let n = prep.layout.size();
+    let (mut h, mut g) = normal_equations(prep, data, posed);
+    // Priors: beta (residual sqrt(c) beta) and the bones' angles (residual sqrt(c) theta_k,
+    // d theta_k / d w_k = A_parent^T, so J^T J = c I and J^T r = c A_parent theta_k).
+    for k in 0..prep.layout.k {
+        let i = prep.layout.beta(k);
+        h[(i, i)] += BETA_PRIOR_MM2;
+        g[i] += BETA_PRIOR_MM2 * params.beta[k];
+    }
+    let parents = &prep.model.skeleton.parents;
+    for (b, theta) in params.theta.iter().enumerate().skip(1) {
+        let above = parents[b].map_or(glam::DMat3::IDENTITY, |p| posed.g[p].matrix3);
+        let pull = above * *theta * POSE_PRIOR_MM2_PER_RAD2;
+        let at = prep.layout.bone(b);
+        for d in 0..3 {
+            h[(at + d, at + d)] += POSE_PRIOR_MM2_PER_RAD2;
+            g[at + d] += pull[d];
+        }
+    }
+    let index: Vec<usize> = (0..n).filter(|&i| active[i]).collect();
+    let m = index.len();
+    let hr = DMatrix::from_fn(m, m, |r, c| h[(index[r], index[c])]);
+    let gr = DVector::from_fn(m, |r, _| g[index[r]]);
+    let before = energy(data, params, posed);
+    let mut lambda = lambda;
+    while lambda <= LAMBDA_MAX {
+        let mut damped = hr.clone();
+        for i in 0..m {
+            damped[(i, i)] += lambda * hr[(i, i)].max(f64::EPSILON);
+        }
+        if let Some(chol) = damped.cholesky() {
+            let dx = chol.solve(&(-&gr));
+            let mut full = vec![0.0; n];
+            index.iter().zip(dx.iter()).for_each(|(&i, &d)| full[i] = d);
+            let next = params.step(prep.layout, posed, parents, &full);
+            let next_posed = prep.pose(&next);
+            let after = energy(data, &next, &next_posed);
+            if after < before {
+                return Step { params: next, before, after, lambda: lambda / LAMBDA_DOWN };
+            }
+        }
+        lambda *= LAMBDA_UP;
+    }
+    Step { params: params.clone(), before, after: before, lambda }
+}
+
+/// `J^T W J` and `J^T W r` of the data term (halved: the cost is `x^T A x - 2 c.x + e`, its
+/// gradient `2 (A x - c)`, its Gauss-Newton Hessian `2 J^T A J`; the priors use the same halves).
+fn normal_equations(
+    prep: &Prepared,
+    data: &Quadratics,
+    posed: &Posed,
+) -> (DMatrix<f64>, DVector<f64>) {
+    let n = prep.layout.size();
+    data.terms
+        .par_iter()
+        .fold(
+            || (DMatrix::zeros(n, n), DVector::zeros(n), Vec::new()),
+            |(mut h, mut g, mut cols), (v, a, c, _)| {
+                prep.jacobian(posed, *v, &mut cols);
+                let r = *a * posed.vertices[*v] - *c;
+                let ac: Vec<DVec3> = cols.iter().map(|(_, col)| *a * *col).collect();
+                for &(i, col) in &cols {
+                    g[i] += col.dot(r);
+                    for (&(j, _), acj) in cols.iter().zip(&ac) {
+                        h[(i, j)] += col.dot(*acj);
+                    }
+                }
+                (h, g, cols)
+            },
+        )
+        .map(|(h, g, _)| (h, g))
+        .reduce(
+            || (DMatrix::zeros(n, n), DVector::zeros(n)),
+            |(h1, g1), (h2, g2)| (h1 + h2, g1 + g2),
+        )
+}
