@@ -7,7 +7,7 @@
 //! symmetrizes, and its girths are within 5 mm of the same body un-posed and clean. The worst
 //! case is printed.
 
-use crate::common;
+use crate::common::{self, uniform};
 use dressform::makehuman::{MakeHuman, Pose};
 use dressform::mannequin::MannequinOptions;
 use dressform::measure::{Measurements, levels, measure_at};
@@ -32,17 +32,6 @@ const HOLE_RADIUS_MM: f64 = 20.0;
 const CENTRE_LINE_MM: f64 = 15.0;
 /// Taubin passes before measuring, as `measure` and `symmetrize` do by default.
 const SMOOTHING_PASSES: usize = 8;
-
-/// A number in `lo..hi` drawn from (`seed`, `k`) (splitmix64): reproducible, no state.
-fn uniform(seed: u64, k: u64, lo: f64, hi: f64) -> f64 {
-    let mut z = seed
-        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        .wrapping_add(k.wrapping_mul(0xBF58_476D_1CE4_E5B9));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^= z >> 31;
-    lo + (hi - lo) * (z >> 11) as f64 / (1u64 << 53) as f64
-}
 
 /// A measurement target by the sign of its weight: `measure-<part>-circ-incr` or `-decr`.
 fn circ(part: &str, weight: f64) -> (String, f64) {

@@ -6,7 +6,7 @@
 //! 15 degrees out. Every body segments; every girth is within 2 mm of the generator's truth;
 //! no torso section holds arm material. The worst case of each stance is printed.
 
-use crate::common::mesh_of;
+use crate::common::{mesh_of, uniform};
 use dressform::measure::{levels, measure_at};
 use dressform::regions::{Armhole, BodyRegions, TRACKING_STEP_MM};
 use glam::DVec3;
@@ -28,17 +28,6 @@ const PLATE_MM: f64 = 15.0;
 /// Each leg's abduction when the legs stand together: the generator's least, where the
 /// thighs (8 mm apart at the hip joints' level) are blended together below the crotch.
 const LEGS_TOGETHER_DEG: f64 = 2.0;
-
-/// A number in `lo..hi` drawn from (`seed`, `k`) (splitmix64): reproducible, no state.
-fn uniform(seed: u64, k: u64, lo: f64, hi: f64) -> f64 {
-    let mut z = seed
-        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        .wrapping_add(k.wrapping_mul(0xBF58_476D_1CE4_E5B9));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^= z >> 31;
-    lo + (hi - lo) * (z >> 11) as f64 / (1u64 << 53) as f64
-}
 
 /// The stances of the acceptance list, as changes to a random A-posed customer.
 #[derive(Debug, Clone, Copy)]

@@ -211,3 +211,14 @@ pub fn surface_mesh(surface: &sim::capture::TriangleSurface) -> Mesh {
         surface.triangles.clone(),
     )
 }
+
+/// A number in `lo..hi` drawn from (`seed`, `k`) (splitmix64): reproducible, no state.
+pub fn uniform(seed: u64, k: u64, lo: f64, hi: f64) -> f64 {
+    let mut z = seed
+        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        .wrapping_add(k.wrapping_mul(0xBF58_476D_1CE4_E5B9));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    lo + (hi - lo) * (z >> 11) as f64 / (1u64 << 53) as f64
+}
