@@ -5,6 +5,9 @@ use crate::mannequin::{self, Mannequin, MannequinError, MannequinOptions};
 use crate::measure::{Comparison, compare, levels};
 use crate::regions::{BodyRegions, TRACKING_STEP_MM};
 use crate::scan::Scan;
+use crate::scan::carried::CarriedBody;
+use crate::scan::format::Export;
+use crate::scan::frame::CanonicalFrame;
 
 /// A scan's symmetric mannequin with its segmentation and measurements.
 #[derive(Debug, Clone)]
@@ -15,6 +18,26 @@ pub struct Symmetrized {
     pub mannequin: Mannequin,
     /// Table 1 and Fig. 11.
     pub comparison: Comparison,
+}
+
+impl Symmetrized {
+    /// The mannequin's file as `export` describes it, with the header line that lets
+    /// dressform read it back as a body ([`CarriedBody`]: frame, own landmarks, levels).
+    /// An export of coordinates as they are ([`crate::scan::format::Placement::AsIs`]) writes the mannequin in the
+    /// frame of the scan it was made from, `scan`.
+    pub fn mannequin_file(&self, export: &Export, scan: &CanonicalFrame) -> Vec<u8> {
+        let mesh = &self.mannequin.mesh;
+        let (mesh, frame) = match export.placement.file_frame() {
+            Some(frame) => (mesh.clone(), frame),
+            None => (mesh.map_positions(|p| scan.to_scan(p)), scan.file_frame()),
+        };
+        let carried = CarriedBody {
+            frame,
+            landmarks: self.mannequin.own_landmarks(),
+            levels: self.comparison.levels,
+        };
+        export.clone().with_comments([carried.header_line()]).encode(&mesh)
+    }
 }
 
 /// The steps of [`symmetrize`], reported to `progress` as they start.

@@ -48,6 +48,9 @@ pub struct FrameInfo {
     pub facing_detected: bool,
     /// How far the feet reach in front of the shins, in mm (near 0: front and back unclear).
     pub facing_evidence_mm: f64,
+    /// `true` when the file's header states the frame (a mannequin dressform wrote): nothing
+    /// was detected, and heights are from the floor of the scan it was made from.
+    pub from_header: bool,
 }
 
 /// The kept body, in the canonical frame (mm, Z up, floor at 0, +X left, facing -Y).
@@ -115,6 +118,7 @@ impl ScanInfo {
                 facing_axis: frame.facing_axis(),
                 facing_detected: frame.facing_detected,
                 facing_evidence_mm: frame.facing_evidence_mm,
+                from_header: frame.from_header,
             },
             body: BodyInfo {
                 vertices: body.positions.len(),
@@ -146,7 +150,11 @@ impl fmt::Display for ScanInfo {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let fr = &self.frame;
         let b = &self.body;
-        let how = |detected: bool| if detected { "detected" } else { "given" };
+        let how = |detected: bool| match (detected, fr.from_header) {
+            (true, _) => "detected",
+            (false, true) => "from the file's header",
+            (false, false) => "given",
+        };
         let facing = match fr.facing_axis {
             Some(axis) => axis.to_string(),
             None => format!("({:.3}, {:.3}, {:.3})", fr.facing[0], fr.facing[1], fr.facing[2]),
@@ -155,12 +163,16 @@ impl fmt::Display for ScanInfo {
         writeln!(f, "  read        {} vertices, {} triangles", self.vertices, self.triangles)?;
         writeln!(f, "  units       {} ({})", fr.units, how(fr.units_detected))?;
         writeln!(f, "  up          {} ({})", fr.up, how(fr.up_detected))?;
-        writeln!(
-            f,
-            "  facing      {facing} ({}; feet {:.0} mm ahead of the shins)",
-            how(fr.facing_detected),
-            fr.facing_evidence_mm
-        )?;
+        if fr.from_header {
+            writeln!(f, "  facing      {facing} ({})", how(false))?;
+        } else {
+            writeln!(
+                f,
+                "  facing      {facing} ({}; feet {:.0} mm ahead of the shins)",
+                how(fr.facing_detected),
+                fr.facing_evidence_mm
+            )?;
+        }
         writeln!(f, "  height      {:.1} mm", b.height_mm)?;
         let (lo, hi) = (b.bounding_box_mm.min, b.bounding_box_mm.max);
         writeln!(

@@ -20,6 +20,7 @@ mod formats;
 mod fuzz_readers;
 mod makehuman;
 mod mannequin;
+mod mannequin_file;
 mod mannequin_quality;
 mod measurements;
 mod outputs;

@@ -73,14 +73,22 @@ fn scan_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, Failure> {
 
 fn measure_one(path: &Path, args: &MeasureArgs) -> Result<MeasureOut, Failure> {
     let mut scan = scan::load(path, &args.frame.options()).map_err(Failure::bad_input)?;
-    scan.body.taubin_smooth(args.smooth.smooth);
     let file = scan.source.display().to_string();
     for w in scan.cleaning.warnings() {
         warn(&file, &w);
     }
-    let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM)
-        .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
-    let levels = levels(&scan.body, &regions);
+    let (regions, levels) = match scan.carried {
+        // A mannequin dressform made: measured as it is (it has no scanner noise to smooth
+        // away), at the levels and with the landmarks its file carries.
+        Some(carried) => (BodyRegions::armless(carried.landmarks), carried.levels),
+        None => {
+            scan.body.taubin_smooth(args.smooth.smooth);
+            let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM)
+                .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
+            let levels = levels(&scan.body, &regions);
+            (regions, levels)
+        }
+    };
     let measurements = measure_at(&scan.body, &regions, &levels);
     let dimensions = dimensions(&scan.body, &regions, &levels);
     let warnings = warnings(&scan.body, &levels);

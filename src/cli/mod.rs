@@ -43,7 +43,6 @@ mod status;
 mod symmetrize;
 
 use clap::{Parser, Subcommand};
-use dressform::mesh::Mesh;
 use dressform::messages;
 use dressform::scan::Scan;
 use dressform::scan::format::{Export, Format, Placement, UpAxis};
@@ -215,12 +214,6 @@ impl ExportArgs {
             (placement, false) => placement.clone(),
         };
         Export::new(format, placement).map_err(Failure::bad_input)
-    }
-
-    /// `mesh` (in the canonical frame) as it goes into the file: moved back into the scan's
-    /// frame with `--scan-frame`.
-    fn placed(&self, scan: &Scan, mesh: &Mesh) -> Mesh {
-        if self.scan_frame { mesh.map_positions(|p| scan.frame.to_scan(p)) } else { mesh.clone() }
     }
 }
 

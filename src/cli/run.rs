@@ -137,7 +137,7 @@ fn write_outputs(
         Failure::other(format!("{}: cannot create the directory: {e}", out.display()))
     })?;
     let export = Export::canonical(Format::Obj);
-    outputs.add(export.file_name("mannequin"), export.encode(&result.mannequin.mesh));
+    outputs.add(export.file_name("mannequin"), result.mannequin_file(&export, &scan.frame));
     outputs.add("profiles.json", serde_json::to_vec_pretty(profiles).map_err(Failure::other)?);
     let measurements = serde_json::to_vec_pretty(&result.comparison).map_err(Failure::other)?;
     outputs.add("measurements.json", measurements);

@@ -3,6 +3,7 @@
 use super::{Failure, FrameArgs, warn};
 use dressform::regions::{BodyRegions, Region, TRACKING_STEP_MM};
 use dressform::scan;
+use dressform::slice::sections;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -57,8 +58,13 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
     for w in scan.cleaning.warnings() {
         warn(&file, &w);
     }
-    let (regions, sections) =
-        BodyRegions::find_and_cut(&scan.body, TRACKING_STEP_MM, &args.heights);
+    let (regions, sections) = match scan.carried {
+        // A mannequin dressform made: labelled by the landmarks its file carries.
+        Some(carried) => {
+            (Ok(BodyRegions::armless(carried.landmarks)), sections(&scan.body, &args.heights))
+        }
+        None => BodyRegions::find_and_cut(&scan.body, TRACKING_STEP_MM, &args.heights),
+    };
     let regions = regions.map_err(|e| warn(&file, &format!("loops are not labelled: {e}"))).ok();
     for s in sections.iter().filter(|s| s.bridged_gaps > 0) {
         warn(

@@ -72,10 +72,9 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     std::fs::create_dir_all(&args.out).map_err(|e| {
         Failure::other(format!("{}: cannot create the directory: {e}", args.out.display()))
     })?;
-    let mesh = args.export.placed(&scan, &result.mannequin.mesh);
     let measurements = pretty_json(&result.comparison)?;
     let mut outputs = OutputSet::new();
-    outputs.add(export.file_name("mannequin"), export.encode(&mesh));
+    outputs.add(export.file_name("mannequin"), result.mannequin_file(&export, &scan.frame));
     let profiles = Profiles::of(&result.mannequin, &result.comparison.levels);
     outputs.add("profiles.json", pretty_json(&profiles)?);
     outputs.add("measurements.json", measurements.clone());

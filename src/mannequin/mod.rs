@@ -14,9 +14,9 @@ mod rebuild;
 mod shoulders;
 
 use crate::mesh::Mesh;
-use crate::regions::{BodyRegions, Landmarks, Region, RegionError};
+use crate::regions::{Armhole, BodyRegions, Landmarks, Region, RegionError};
 use crate::symmetry::{Preserve, SymmetryError};
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 use serde::Serialize;
 
 /// How the mannequin is built.
@@ -81,6 +81,37 @@ pub struct Mannequin {
     pub right_leg: Vec<Layer>,
     /// The watertight, consistently oriented mannequin mesh.
     pub mesh: Mesh,
+}
+
+impl Mannequin {
+    /// The mannequin's own landmarks: the input body's, made symmetric about the plane
+    /// x = `axis` as the mannequin is — each armhole the mean of its own and the other one
+    /// mirrored, both armpits at their mean height, the centre line on the plane. Its file
+    /// carries them ([`crate::scan::carried`]).
+    pub fn own_landmarks(&self) -> Landmarks {
+        let m = &self.landmarks;
+        let mirror = |p: DVec3| DVec3::new(2.0 * self.axis - p.x, p.y, p.z);
+        let flip = |n: DVec3| DVec3::new(-n.x, n.y, n.z);
+        let (l, r) = (&m.left_armhole, &m.right_armhole);
+        let left = Armhole {
+            armpit: 0.5 * (l.armpit + mirror(r.armpit)),
+            shoulder_point: 0.5 * (l.shoulder_point + mirror(r.shoulder_point)),
+            normal: (l.normal + flip(r.normal)).normalize_or(l.normal),
+        };
+        let right = Armhole {
+            armpit: mirror(left.armpit),
+            shoulder_point: mirror(left.shoulder_point),
+            normal: flip(left.normal),
+        };
+        Landmarks {
+            left_armpit: left.armpit.z,
+            right_armpit: left.armpit.z,
+            centre_x: self.axis,
+            left_armhole: left,
+            right_armhole: right,
+            ..*m
+        }
+    }
 }
 
 /// Why a mannequin could not be built.

@@ -127,7 +127,8 @@ pub enum RegionError {
     },
     /// No arm loop below the armpits on one side.
     #[error(
-        "no {side} arm found beside the torso (arms must hang clear of the torso, as in an A-pose)"
+        "no {side} arm found beside the torso (arms must hang clear of it, as in an A-pose; \
+         read a mannequin from the OBJ, PLY or glb file dressform wrote)"
     )]
     NoArm {
         /// "left" or "right".
@@ -135,13 +136,23 @@ pub enum RegionError {
     },
 }
 
-/// A body's tracked levels and landmarks; labels loops of any section.
+/// A body's landmarks and how its loops are labelled; labels loops of any section.
 #[derive(Debug, Clone)]
 pub struct BodyRegions {
-    /// The landmarks found.
+    /// The landmarks found (or carried, see [`BodyRegions::armless`]).
     pub landmarks: Landmarks,
-    step: f64,
-    levels: Vec<LabelledSection>,
+    labelling: Labelling,
+}
+
+/// How the loops of a section are labelled.
+#[derive(Debug, Clone)]
+enum Labelling {
+    /// By the levels tracked on the body (spaced `step` mm), for a scan.
+    Tracked { step: f64, levels: Vec<LabelledSection> },
+    /// By the landmarks alone, for a body without arms and head whose landmarks are known (a
+    /// mannequin dressform made): below the crotch a leg, by its side of the centre line;
+    /// above, the torso.
+    Armless,
 }
 
 /// One tracked level: its loops and their labels.
@@ -155,6 +166,12 @@ struct LabelledSection {
 pub const TRACKING_STEP_MM: f64 = 5.0;
 
 impl BodyRegions {
+    /// The regions of a body without arms and head (a mannequin dressform made, whose
+    /// `landmarks` its file carries): the torso above the crotch, the legs below.
+    pub fn armless(landmarks: Landmarks) -> BodyRegions {
+        BodyRegions { landmarks, labelling: Labelling::Armless }
+    }
+
     /// Segments `body` (canonical frame), tracking loops every `step` mm.
     pub fn find(body: &Mesh, step: f64) -> Result<BodyRegions, RegionError> {
         Self::find_and_cut(body, step, &[]).0
@@ -180,7 +197,8 @@ impl BodyRegions {
 
     /// The torso's section at each of `heights` (`None` where there is none): the largest
     /// loop labelled torso (at and above the neck, head), clipped to the inner side of both
-    /// armholes (above each armpit), so that it holds no arm material.
+    /// armholes (above each armpit), so that it holds no arm material (an armless body has
+    /// none, and is not clipped).
     pub fn torso_sections(&self, body: &Mesh, heights: &[f64]) -> Vec<Option<Contour>> {
         let m = &self.landmarks;
         sections(body, heights)
@@ -189,9 +207,12 @@ impl BodyRegions {
                 let labels = self.label(&s);
                 let found = largest_with(&s, &labels, Region::Torso)
                     .or_else(|| largest_with(&s, &labels, Region::Head));
-                found.map(|c| {
-                    let c = m.left_armhole.clip(c, s.height);
-                    m.right_armhole.clip(&c, s.height)
+                found.map(|c| match self.labelling {
+                    Labelling::Tracked { .. } => {
+                        let c = m.left_armhole.clip(c, s.height);
+                        m.right_armhole.clip(&c, s.height)
+                    }
+                    Labelling::Armless => c.clone(),
                 })
             })
             .collect()
@@ -220,15 +241,24 @@ impl BodyRegions {
     /// that a cut just below the crotch or an armpit is never labelled from a level above it.
     pub fn label(&self, section: &Section) -> Vec<Region> {
         let z = section.height;
-        let band = self.landmarks.band(z);
-        let level = self
-            .levels
+        let m = &self.landmarks;
+        let (step, levels) = match &self.labelling {
+            Labelling::Tracked { step, levels } => (*step, levels),
+            Labelling::Armless => {
+                let side = |c: DVec2| side(c.x - m.centre_x, Region::LeftLeg, Region::RightLeg);
+                let region =
+                    |l: &Contour| if z < m.crotch { side(l.centroid()) } else { Region::Torso };
+                return section.loops.iter().map(region).collect();
+            }
+        };
+        let band = m.band(z);
+        let level = levels
             .iter()
             .filter(|l| self.landmarks.band(l.section.height) == band)
             .min_by(|a, b| (a.section.height - z).abs().total_cmp(&(b.section.height - z).abs()))
             .unwrap_or_else(|| {
-                let i = ((z - self.levels[0].section.height) / self.step).round();
-                &self.levels[(i.max(0.0) as usize).min(self.levels.len() - 1)]
+                let i = ((z - levels[0].section.height) / step).round();
+                &levels[(i.max(0.0) as usize).min(levels.len() - 1)]
             });
         section
             .loops
@@ -246,7 +276,7 @@ impl BodyRegions {
                 };
                 match inside.or_else(nearest) {
                     Some(k) => level.labels[k],
-                    None => fallback_region(c, section.height, &self.landmarks),
+                    None => fallback_region(c, section.height, m),
                 }
             })
             .collect()

@@ -338,5 +338,5 @@ pub(super) fn track(
             LabelledSection { section, labels }
         })
         .collect();
-    Ok(BodyRegions { landmarks, step, levels })
+    Ok(BodyRegions { landmarks, labelling: super::Labelling::Tracked { step, levels } })
 }

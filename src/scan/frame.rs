@@ -19,7 +19,7 @@
 use crate::mesh::{Aabb, Mesh};
 use crate::slice::sections;
 use glam::{DMat3, DVec2, DVec3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
@@ -28,7 +28,7 @@ use std::str::FromStr;
 pub const PERSON_HEIGHT_MM: (f64, f64) = (500.0, 2500.0);
 
 /// A length unit a scan may be stored in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Units {
     /// Metres.
@@ -203,6 +203,9 @@ pub struct CanonicalFrame {
     pub facing_evidence_mm: f64,
     /// Height of the body in mm.
     pub height_mm: f64,
+    /// Whether the frame was stated in the file's header (a file dressform wrote, see
+    /// [`FileFrame`]) rather than detected or given.
+    pub from_header: bool,
     #[serde(skip)]
     rotation: DMat3,
     #[serde(skip)]
@@ -235,11 +238,72 @@ impl CanonicalFrame {
         self.translation -= shift;
     }
 
+    /// The map from the scan's coordinates to this frame, as a header states it.
+    pub fn file_frame(&self) -> FileFrame {
+        FileFrame {
+            units: self.units,
+            rotation: self.rotation.transpose().to_cols_array_2d(),
+            translation: self.translation.to_array(),
+        }
+    }
+
+    /// The frame a file's header states (see [`FileFrame`]), for `mesh` in the file's
+    /// coordinates: no detection, no centring, the floor where the header puts it.
+    pub fn stated(file: &FileFrame, mesh: &Mesh) -> Result<CanonicalFrame, String> {
+        let rotation = DMat3::from_cols_array_2d(&file.rotation).transpose();
+        let orthonormal = (rotation * rotation.transpose() - DMat3::IDENTITY)
+            .to_cols_array()
+            .iter()
+            .all(|e| e.abs() <= ROTATION_TOLERANCE);
+        if !orthonormal || (rotation.determinant() - 1.0).abs() > ROTATION_TOLERANCE {
+            return Err("rotation: not a rotation matrix".to_string());
+        }
+        let translation = DVec3::from_array(file.translation);
+        if !translation.is_finite() {
+            return Err("translation_mm: not finite".to_string());
+        }
+        let up = Direction::nearest(rotation.transpose() * DVec3::Z)
+            .ok_or("rotation: the up direction is not an axis of the file")?;
+        let mut frame = CanonicalFrame {
+            units: file.units,
+            units_detected: false,
+            up,
+            up_detected: false,
+            facing: rotation.transpose() * DVec3::NEG_Y,
+            facing_detected: false,
+            facing_evidence_mm: 0.0,
+            height_mm: 0.0,
+            from_header: true,
+            rotation,
+            translation,
+        };
+        let top = mesh.positions.iter().map(|&p| frame.to_canonical(p).z).fold(0.0, f64::max);
+        frame.height_mm = top;
+        Ok(frame)
+    }
+
     /// `facing` as an axis name when it is one (within 1 degree).
     pub fn facing_axis(&self) -> Option<Direction> {
         Direction::nearest(self.facing)
     }
 }
+
+/// How a file's coordinates map to the canonical frame, as the header of a file dressform
+/// wrote states it: `canonical = rotation (p units) + translation`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FileFrame {
+    /// The file's unit.
+    pub units: Units,
+    /// The rotation, row by row.
+    pub rotation: [[f64; 3]; 3],
+    /// The translation (mm).
+    #[serde(rename = "translation_mm")]
+    pub translation: [f64; 3],
+}
+
+/// How far a stated rotation may be from orthonormal: a header writes its entries to about
+/// 17 significant digits, so only a corrupted one comes near this.
+const ROTATION_TOLERANCE: f64 = 1e-6;
 
 /// Area-weighted sums over triangle centroids: weight, first moment, and the second moments
 /// of two horizontal coordinates.
@@ -421,6 +485,7 @@ pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, Fra
         facing_detected,
         facing_evidence_mm: evidence.abs() * scale,
         height_mm: height * scale,
+        from_header: false,
         rotation,
         translation,
     })

@@ -5,12 +5,14 @@
 //! file bytes --format--> Mesh --clean--> body Mesh --frame--> canonical body Mesh
 //! ```
 
+pub mod carried;
 pub mod clean;
 pub mod format;
 pub mod frame;
 
 use crate::mesh::{Aabb, Mesh};
 use crate::messages;
+use carried::CarriedBody;
 use clean::{CleanError, CleaningReport};
 use format::{Format, MeshFile, ReadError};
 use frame::{CanonicalFrame, FrameError, FrameOptions};
@@ -34,6 +36,9 @@ pub struct Scan {
     /// The comments of the file's header (see [`MeshFile::comments`]); none for a mesh that
     /// came from no file.
     pub comments: Vec<String>,
+    /// What the header of a file dressform wrote (a mannequin) says about the body: its
+    /// frame (used instead of detecting one), landmarks and levels.
+    pub carried: Option<CarriedBody>,
 }
 
 /// Why a scan could not be loaded. Every message starts with the file's name.
@@ -83,6 +88,14 @@ pub enum ScanError {
         path: PathBuf,
         /// What is wrong.
         error: CleanError,
+    },
+    /// The header of a file dressform wrote is unusable.
+    #[error("{}: {error}", messages::path(path))]
+    Header {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        error: String,
     },
     /// The canonical frame could not be found.
     #[error("{}: {error}", messages::path(path))]
@@ -186,12 +199,11 @@ impl std::ops::Deref for FileBytes {
     }
 }
 
-/// Loads the scan at `path`: read, clean, canonical frame.
+/// Loads the scan at `path`: read, clean, canonical frame (the one its header states, for a
+/// file dressform wrote; see [`carried`]).
 pub fn load(path: &Path, options: &FrameOptions) -> Result<Scan, ScanError> {
     let (file, _) = read_mesh_file(path)?;
-    let mut scan = from_mesh(file.mesh, path, options)?;
-    scan.comments = file.comments;
-    Ok(scan)
+    from_file(file, path, options)
 }
 
 /// Loads a scan from `bytes` in the format `source`'s extension names (`source` names it in
@@ -204,7 +216,39 @@ pub fn from_bytes(bytes: &[u8], source: &Path, options: &FrameOptions) -> Result
         format,
         error,
     })?;
-    let mut scan = from_mesh(file.mesh, source, options)?;
+    from_file(file, source, options)
+}
+
+/// [`from_mesh`] for a mesh read from a file: a header stating the body's frame (a file
+/// dressform wrote) takes the place of detecting it, and `options` are not needed.
+fn from_file(file: MeshFile, source: &Path, options: &FrameOptions) -> Result<Scan, ScanError> {
+    let carried = CarriedBody::from_comments(&file.comments)
+        .map_err(|error| ScanError::Header { path: source.into(), error })?;
+    let mut scan = match carried {
+        None => from_mesh(file.mesh, source, options)?,
+        Some(carried) => {
+            let (raw_vertices, raw_triangles) =
+                (file.mesh.positions.len(), file.mesh.triangles.len());
+            let (mut body, cleaning) = clean::clean(file.mesh)
+                .map_err(|error| ScanError::Clean { path: source.into(), error })?;
+            let frame = CanonicalFrame::stated(&carried.frame, &body).map_err(|e| {
+                let error = format!("header line '{}:': frame.{e}", carried::HEADER_KEY);
+                ScanError::Header { path: source.into(), error }
+            })?;
+            body.transform(|p| frame.to_canonical(p));
+            let source = source.into();
+            Scan {
+                source,
+                raw_vertices,
+                raw_triangles,
+                cleaning,
+                frame,
+                body,
+                comments: vec![],
+                carried: Some(carried),
+            }
+        }
+    };
     scan.comments = file.comments;
     Ok(scan)
 }
@@ -220,7 +264,16 @@ pub fn from_mesh(mesh: Mesh, source: &Path, options: &FrameOptions) -> Result<Sc
     body.transform(|p| frame.to_canonical(p));
     frame.centre_on_torso(&mut body);
     let source = source.into();
-    Ok(Scan { source, raw_vertices, raw_triangles, cleaning, frame, body, comments: Vec::new() })
+    Ok(Scan {
+        source,
+        raw_vertices,
+        raw_triangles,
+        cleaning,
+        frame,
+        body,
+        comments: Vec::new(),
+        carried: None,
+    })
 }
 
 /// Serialises a box as `{"min": [x, y, z], "max": [x, y, z]}`.

@@ -9,7 +9,7 @@
 
 use super::Format;
 use crate::mesh::Mesh;
-use crate::scan::frame::Units;
+use crate::scan::frame::{FileFrame, Units};
 use glam::DVec3;
 
 /// The grid output coordinates are rounded to, in mm (issue 12: 0.001 mm).
@@ -44,6 +44,20 @@ pub enum Placement {
         /// A description of the axes.
         frame: String,
     },
+}
+
+impl Placement {
+    /// How the file's coordinates map back to the canonical frame, for a canonical placement
+    /// (`None` for coordinates as they are: only their owner knows what they are).
+    pub fn file_frame(&self) -> Option<FileFrame> {
+        let Placement::Canonical { units, up } = self else { return None };
+        let rotation = match up {
+            UpAxis::Z => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            // The inverse of (x, y, z) -> (x, z, -y).
+            UpAxis::Y => [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]],
+        };
+        Some(FileFrame { units: *units, rotation, translation: [0.0; 3] })
+    }
 }
 
 /// A mesh file to write.
