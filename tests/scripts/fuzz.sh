@@ -2,9 +2,9 @@
 # Runs every cargo-fuzz target of tests/fuzz for SECONDS each (default 600), seeded with
 # tests/fuzz/seeds/<target>, with a 2 s per-input timeout and a 2 GB memory limit, and prints
 # one line per target: runs, crashes, timeouts, out-of-memory, coverage, corpus size.
-# Exit status 1 if any target found a crash, a timeout or an out-of-memory input (kept in
-# tests/fuzz/artifacts/<target>/). Needs `cargo install cargo-fuzz`; stable Rust is enough
-# (RUSTC_BOOTSTRAP lets cargo-fuzz use the sanitizer flags).
+# Exit status 1 if any target did not run, or found a crash, a timeout or an out-of-memory
+# input (kept in tests/fuzz/artifacts/<target>/). Needs `cargo install cargo-fuzz`; stable
+# Rust is enough (RUSTC_BOOTSTRAP lets cargo-fuzz use the sanitizer flags).
 #
 # Usage: tests/scripts/fuzz.sh [SECONDS] [TARGET...]
 set -uo pipefail
@@ -31,7 +31,9 @@ for t in "${targets[@]}"; do
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | cut -d' ' -f2)
   printf '%-10s %12s %8s %9s %5s %9s %7s\n' "$t" "${runs:-?}" "$(count crash)" \
     "$(count timeout)" "$(count oom)" "${cov:-?}" "$(find "$corpus" -type f | wc -l)"
-  if [ "$(count crash)" != 0 ] || [ "$(count timeout)" != 0 ] || [ "$(count oom)" != 0 ]; then
+  # A target that did not run (unknown name, build failure) has no statistics: a failure too.
+  if [ -z "$runs" ] || [ "$(count crash)" != 0 ] || [ "$(count timeout)" != 0 ] ||
+    [ "$(count oom)" != 0 ]; then
     failed=1
     tail -40 "$log"
   fi
