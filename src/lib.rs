@@ -20,7 +20,8 @@
 //! - [`setpoints`]: the set-point file (actuator id → extension, mm) the controller drives to;
 //! - [`controller`]: the host controller: drives the robotic form over serial, slcan, SocketCAN or the simulated bus;
 //! - [`makehuman`]: the CC0 MakeHuman assets (base mesh, targets, 163-bone rig, weights) and posing them;
-//! - [`skinning`]: linear blend skinning (eq. 3) and its angle convention.
+//! - [`skinning`]: linear blend skinning (eq. 3) and its angle convention;
+//! - [`rig_transfer`]: the fitted model's skin weights given to the scan.
 
 pub mod body_model;
 pub mod controller;
@@ -38,6 +39,7 @@ pub mod preview;
 pub mod profiles;
 pub mod regions;
 pub mod report;
+pub mod rig_transfer;
 pub mod scan;
 pub mod setpoints;
 pub mod skinning;
