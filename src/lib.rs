@@ -12,6 +12,7 @@
 //! - [`fitting`]: the robotic form's rings placed on the mannequin, set-points, fidelity;
 //! - [`mannequin`]: the symmetric mannequin: layers, symmetry, watertight rebuild;
 //! - [`measure`]: height, crotch height, chest/waist/hip girths; Table 1 and Fig. 11;
+//! - [`reconstruct`]: pose symmetry first (fit, rig transfer, re-pose), then the mannequin;
 //! - [`pipeline`]: scan to mannequin in one call; [`profiles`]: the `profiles.json` format;
 //! - [`preview`]: pictures of a result: `preview.png` and `sections.svg`;
 //! - [`report`]: what `dressform info` says about a scan;
@@ -20,7 +21,9 @@
 //! - [`setpoints`]: the set-point file (actuator id → extension, mm) the controller drives to;
 //! - [`controller`]: the host controller: drives the robotic form over serial, slcan, SocketCAN or the simulated bus;
 //! - [`makehuman`]: the CC0 MakeHuman assets (base mesh, targets, 163-bone rig, weights) and posing them;
-//! - [`skinning`]: linear blend skinning (eq. 3) and its angle convention.
+//! - [`skinning`]: linear blend skinning (eq. 3) and its angle convention;
+//! - [`pose_symmetry`]: the fitted pose made symmetric, the scan re-posed to it;
+//! - [`rig_transfer`]: the fitted model's skin weights given to the scan.
 
 pub mod body_model;
 pub mod controller;
@@ -34,10 +37,13 @@ pub mod mesh;
 pub mod messages;
 pub mod output;
 pub mod pipeline;
+pub mod pose_symmetry;
 pub mod preview;
 pub mod profiles;
+pub mod reconstruct;
 pub mod regions;
 pub mod report;
+pub mod rig_transfer;
 pub mod scan;
 pub mod setpoints;
 pub mod skinning;

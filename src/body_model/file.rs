@@ -163,6 +163,100 @@ impl Builder {
             sparse: None,
         })
     }
+
+    /// `JOINTS_0` (`u8`) and `WEIGHTS_0` (`f32`) of `weights`, four slots per vertex.
+    fn skin_attributes(
+        &mut self,
+        weights: &SkinWeights,
+    ) -> (json::Index<json::Accessor>, json::Index<json::Accessor>) {
+        use json::accessor::{ComponentType as C, Type as T};
+        let (mut joints, mut values) = (Vec::new(), Vec::new());
+        for v in 0..weights.len() {
+            let mut slots: Vec<(usize, f64)> = weights.of(v).collect();
+            slots.resize(4, (0, 0.0));
+            joints.extend(slots.iter().map(|&(bone, _)| bone as u8));
+            values.extend(slots.iter().flat_map(|&(_, w)| (w as f32).to_le_bytes()));
+        }
+        let n = weights.len();
+        (
+            self.accessor(&joints, n, C::U8, T::Vec4, false, None, None, VERTICES),
+            self.accessor(&values, n, C::F32, T::Vec4, false, None, None, VERTICES),
+        )
+    }
+
+    /// The skeleton as a skin: one node per bone at its joint `at` (canonical frame; relative
+    /// to the parent), inverse binds -joint. Returns the skin and the root bone's node.
+    fn skeleton(
+        &mut self,
+        skeleton: &Skeleton,
+        at: &[DVec3],
+    ) -> (json::Index<json::Skin>, json::Index<json::Node>) {
+        use json::accessor::{ComponentType as C, Type as T};
+        let first_bone = self.root.nodes.len() as u32;
+        let mut children: Vec<Vec<json::Index<json::Node>>> = vec![Vec::new(); at.len()];
+        for (l, parent) in skeleton.parents.iter().enumerate() {
+            if let Some(p) = parent {
+                children[*p].push(json::Index::new(first_bone + l as u32));
+            }
+        }
+        for (l, name) in skeleton.names.iter().enumerate() {
+            let above = skeleton.parents[l].map_or(DVec3::ZERO, |p| at[p]);
+            let offset = to_gltf(at[l])
+                .iter()
+                .zip(to_gltf(above))
+                .map(|(a, b)| (a - b) as f32)
+                .collect::<Vec<_>>();
+            self.root.push(json::Node {
+                name: Some(name.clone()),
+                translation: Some([offset[0], offset[1], offset[2]]),
+                children: Some(std::mem::take(&mut children[l])).filter(|c| !c.is_empty()),
+                ..Default::default()
+            });
+        }
+        let inverse_binds: Vec<u8> = at
+            .iter()
+            .flat_map(|&j| {
+                let t = to_gltf(j).map(|c| -c as f32);
+                let mut m = glam::Mat4::IDENTITY.to_cols_array();
+                m[12..15].copy_from_slice(&t);
+                m.into_iter().flat_map(f32::to_le_bytes).collect::<Vec<_>>()
+            })
+            .collect();
+        let ibm = self.accessor(&inverse_binds, at.len(), C::F32, T::Mat4, false, None, None, None);
+        let bones: Vec<json::Index<json::Node>> =
+            (0..at.len() as u32).map(|l| json::Index::new(first_bone + l)).collect();
+        let root_bone = bones[skeleton.parents.iter().position(Option::is_none).unwrap_or(0)];
+        let skin = self.root.push(json::Skin {
+            extensions: None,
+            extras: None,
+            inverse_bind_matrices: Some(ibm),
+            joints: bones,
+            name: Some("skeleton".into()),
+            skeleton: Some(root_bone),
+        });
+        (skin, root_bone)
+    }
+
+    /// The `.glb` bytes: the binary chunk padded, its buffer declared.
+    fn finish(mut self) -> Vec<u8> {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        self.root.buffers.push(json::Buffer {
+            byte_length: USize64::from(self.bin.len()),
+            name: None,
+            uri: None,
+            extensions: None,
+            extras: None,
+        });
+        let json_bytes = serde_json::to_vec(&self.root).unwrap_or_default();
+        let glb = gltf::binary::Glb {
+            header: gltf::binary::Header { magic: *b"glTF", version: 2, length: 0 },
+            json: json_bytes.into(),
+            bin: Some(self.bin.into()),
+        };
+        glb.to_vec().unwrap_or_default()
+    }
 }
 
 /// Per-axis bounds of glTF points, as the file stores them.
@@ -211,17 +305,7 @@ pub fn to_bytes(model: &BodyModel) -> Vec<u8> {
         None,
         Some(json::buffer::Target::ElementArrayBuffer),
     );
-    let (mut joints, mut weights) = (Vec::new(), Vec::new());
-    for v in 0..model.weights.len() {
-        let mut slots: Vec<(usize, f64)> = model.weights.of(v).collect();
-        slots.resize(4, (0, 0.0));
-        joints.extend(slots.iter().map(|&(bone, _)| bone as u8));
-        weights.extend(slots.iter().flat_map(|&(_, w)| (w as f32).to_le_bytes()));
-    }
-    let joints_0 =
-        b.accessor(&joints, model.weights.len(), C::U8, T::Vec4, false, None, None, VERTICES);
-    let weights_0 =
-        b.accessor(&weights, model.weights.len(), C::F32, T::Vec4, false, None, None, VERTICES);
+    let (joints_0, weights_0) = b.skin_attributes(&model.weights);
     let targets: Vec<json::mesh::MorphTarget> = model
         .components
         .iter()
@@ -269,66 +353,8 @@ pub fn to_bytes(model: &BodyModel) -> Vec<u8> {
         }],
         weights: Some(vec![0.0; model.k()]),
     });
-    // Bones: nodes at their rest joints (relative to the parent), inverse binds -joint.
     let rest = model.regress_joints(&model.mean).into_iter().map(round_f32).collect::<Vec<_>>();
-    let first_bone = b.root.nodes.len() as u32;
-    let mut children: Vec<Vec<json::Index<json::Node>>> = vec![Vec::new(); rest.len()];
-    for (l, parent) in model.skeleton.parents.iter().enumerate() {
-        if let Some(p) = parent {
-            children[*p].push(json::Index::new(first_bone + l as u32));
-        }
-    }
-    for (l, name) in model.skeleton.names.iter().enumerate() {
-        let above = model.skeleton.parents[l].map_or(DVec3::ZERO, |p| rest[p]);
-        let offset = to_gltf(rest[l])
-            .iter()
-            .zip(to_gltf(above))
-            .map(|(a, b)| (a - b) as f32)
-            .collect::<Vec<_>>();
-        b.root.push(json::Node {
-            name: Some(name.clone()),
-            translation: Some([offset[0], offset[1], offset[2]]),
-            children: Some(std::mem::take(&mut children[l])).filter(|c| !c.is_empty()),
-            ..Default::default()
-        });
-    }
-    let inverse_binds: Vec<u8> = rest
-        .iter()
-        .flat_map(|&j| {
-            let t = to_gltf(j);
-            let m: [f32; 16] = [
-                1.0,
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-                1.0,
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-                1.0,
-                0.0,
-                -t[0] as f32,
-                -t[1] as f32,
-                -t[2] as f32,
-                1.0,
-            ];
-            m.into_iter().flat_map(f32::to_le_bytes).collect::<Vec<_>>()
-        })
-        .collect();
-    let ibm = b.accessor(&inverse_binds, rest.len(), C::F32, T::Mat4, false, None, None, None);
-    let bones: Vec<json::Index<json::Node>> =
-        (0..rest.len() as u32).map(|l| json::Index::new(first_bone + l)).collect();
-    let root_bone = bones[model.skeleton.parents.iter().position(Option::is_none).unwrap_or(0)];
-    let skin = b.root.push(json::Skin {
-        extensions: None,
-        extras: None,
-        inverse_bind_matrices: Some(ibm),
-        joints: bones,
-        name: Some("skeleton".into()),
-        skeleton: Some(root_bone),
-    });
+    let (skin, root_bone) = b.skeleton(&model.skeleton, &rest);
     let body = b.root.push(json::Node {
         name: Some("body".into()),
         mesh: Some(mesh),
@@ -376,23 +402,72 @@ pub fn to_bytes(model: &BodyModel) -> Vec<u8> {
         copyright: Some("Derived from the MakeHuman assets (CC0 1.0)".into()),
         ..Default::default()
     };
-    while !b.bin.len().is_multiple_of(4) {
-        b.bin.push(0);
-    }
-    b.root.buffers.push(json::Buffer {
-        byte_length: USize64::from(b.bin.len()),
-        name: None,
-        uri: None,
+    b.finish()
+}
+
+/// A scan rigged with a skeleton as `.glb` (metres, Y up, facing +Z): the mesh bound as it
+/// stands, with `weights` (at most four bones per vertex), the bones at `joints` (canonical
+/// frame, mm; the fitted pose's joints). Moving a bone's node re-poses the scan (eq. 3).
+pub fn rigged_to_bytes(
+    mesh: &crate::mesh::Mesh,
+    weights: &SkinWeights,
+    skeleton: &Skeleton,
+    joints: &[DVec3],
+) -> Vec<u8> {
+    use json::accessor::{ComponentType as C, Type as T};
+    let mut b = Builder { root: json::Root::default(), bin: Vec::new() };
+    let stored: Vec<[f32; 3]> =
+        mesh.positions.iter().map(|&p| to_gltf(p).map(|c| c as f32)).collect();
+    let position_bytes: Vec<u8> = stored.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+    let extent = bounds(stored.iter().map(|p| p.map(f64::from)));
+    let n = stored.len();
+    let positions =
+        b.accessor(&position_bytes, n, C::F32, T::Vec3, false, None, Some(extent), VERTICES);
+    let index_bytes: Vec<u8> =
+        mesh.triangles.iter().flatten().flat_map(|&i| i.to_le_bytes()).collect();
+    let target = Some(json::buffer::Target::ElementArrayBuffer);
+    let count = mesh.triangles.len() * 3;
+    let indices = b.accessor(&index_bytes, count, C::U32, T::Scalar, false, None, None, target);
+    let (joints_0, weights_0) = b.skin_attributes(weights);
+    let body_mesh = b.root.push(json::Mesh {
         extensions: None,
         extras: None,
+        name: Some("scan".into()),
+        primitives: vec![json::mesh::Primitive {
+            attributes: BTreeMap::from([
+                (Valid(json::mesh::Semantic::Positions), positions),
+                (Valid(json::mesh::Semantic::Joints(0)), joints_0),
+                (Valid(json::mesh::Semantic::Weights(0)), weights_0),
+            ]),
+            extensions: None,
+            extras: None,
+            indices: Some(indices),
+            material: None,
+            mode: Valid(json::mesh::Mode::Triangles),
+            targets: None,
+        }],
+        weights: None,
     });
-    let json_bytes = serde_json::to_vec(&b.root).unwrap_or_default();
-    let glb = gltf::binary::Glb {
-        header: gltf::binary::Header { magic: *b"glTF", version: 2, length: 0 },
-        json: json_bytes.into(),
-        bin: Some(b.bin.into()),
+    let at: Vec<DVec3> = joints.iter().map(|&j| round_f32(j)).collect();
+    let (skin, root_bone) = b.skeleton(skeleton, &at);
+    let body = b.root.push(json::Node {
+        name: Some("scan".into()),
+        mesh: Some(body_mesh),
+        skin: Some(skin),
+        ..Default::default()
+    });
+    let scene = b.root.push(json::Scene {
+        extensions: None,
+        extras: None,
+        name: None,
+        nodes: vec![body, root_bone],
+    });
+    b.root.scene = Some(scene);
+    b.root.asset = json::Asset {
+        generator: Some(format!("dressform {}", env!("CARGO_PKG_VERSION"))),
+        ..Default::default()
     };
-    glb.to_vec().unwrap_or_default()
+    b.finish()
 }
 
 /// Writes `model` to `path` atomically.

@@ -33,6 +33,7 @@ mod info;
 mod link;
 mod measure;
 mod model;
+mod reconstruct;
 mod reset;
 mod run;
 mod setpoints;
@@ -47,6 +48,7 @@ use dressform::messages;
 use dressform::scan::Scan;
 use dressform::scan::format::{Export, Format, Placement, UpAxis};
 use dressform::scan::frame::{Direction, FrameOptions, Units};
+use dressform::symmetry::Preserve;
 use std::io::{ErrorKind, Write};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -68,6 +70,8 @@ enum Command {
     Measure(measure::MeasureArgs),
     /// Build the symmetric mannequin of a scan: mannequin.obj, profiles.json, measurements.json.
     Symmetrize(symmetrize::SymmetrizeArgs),
+    /// Pose symmetry, then the mannequin: fit the body model, re-pose the scan symmetric, build.
+    Reconstruct(reconstruct::ReconstructArgs),
     /// Compute the actuator set-points that give the robotic form a mannequin's shape.
     Setpoints(setpoints::SetpointsArgs),
     /// Scan to shaped form in one command: mannequin, set-points, drive, girth report.
@@ -137,6 +141,34 @@ pub struct ScanFrameArgs {
 impl ScanFrameArgs {
     fn options(&self) -> FrameOptions {
         FrameOptions { units: self.scan_units, up: self.scan_up, facing: self.scan_facing }
+    }
+}
+
+/// How a command builds the mannequin.
+#[derive(Debug, Clone, clap::Args)]
+pub struct MannequinArgs {
+    /// Torso layers.
+    #[arg(long, default_value_t = 100)]
+    torso_layers: usize,
+    /// Leg layers.
+    #[arg(long, default_value_t = 50)]
+    leg_layers: usize,
+    /// Rays per section (even).
+    #[arg(long, default_value_t = 360)]
+    rays: usize,
+    /// The girth every layer keeps: tape (convex hull) or contour (the paper's rule).
+    #[arg(long, value_enum, default_value_t = Preserve::Tape)]
+    preserve: Preserve,
+}
+
+impl MannequinArgs {
+    fn options(&self) -> dressform::mannequin::MannequinOptions {
+        dressform::mannequin::MannequinOptions {
+            torso_layers: self.torso_layers,
+            leg_layers: self.leg_layers,
+            rays: self.rays,
+            preserve: self.preserve,
+        }
     }
 }
 
@@ -243,6 +275,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         Command::Slice(a) => slice::run(&a),
         Command::Measure(a) => measure::run(&a),
         Command::Symmetrize(a) => symmetrize::run(&a),
+        Command::Reconstruct(a) => reconstruct::run(&a),
         Command::Setpoints(a) => setpoints::run(&a),
         Command::Run(a) => run::run(&a),
         Command::Sim(a) => sim::run(&a),

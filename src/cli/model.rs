@@ -76,7 +76,7 @@ pub fn run(args: &ModelArgs) -> Result<(), Failure> {
 }
 
 /// The model in `path`, or the built-in one.
-fn load(path: Option<&Path>) -> Result<BodyModel, Failure> {
+pub(super) fn load(path: Option<&Path>) -> Result<BodyModel, Failure> {
     match path {
         Some(p) => file::read(p).map_err(Failure::bad_input),
         None => Ok(BodyModel::builtin()),

@@ -2,8 +2,7 @@
 //! [--preserve tape|contour] [--format obj|ply|stl|glb] [--units mm|cm|m] [--up z|y]
 //! [--scan-frame] [--json]`.
 
-use super::{ExportArgs, Failure, ScanFrameArgs, SmoothArgs, progress_bar, warn};
-use dressform::mannequin::MannequinOptions;
+use super::{ExportArgs, Failure, MannequinArgs, ScanFrameArgs, SmoothArgs, progress_bar, warn};
 use dressform::measure::Comparison;
 use dressform::mesh::topology;
 use dressform::output::OutputSet;
@@ -11,7 +10,6 @@ use dressform::pipeline::{STEPS, symmetrize};
 use dressform::preview::{preview_png, sections_svg};
 use dressform::profiles::Profiles;
 use dressform::scan;
-use dressform::symmetry::Preserve;
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
@@ -22,18 +20,8 @@ pub struct SymmetrizeArgs {
     /// profiles.json, measurements.json, preview.png, sections.svg, replaced as a whole.
     #[arg(short, long)]
     out: PathBuf,
-    /// Torso layers.
-    #[arg(long, default_value_t = 100)]
-    torso_layers: usize,
-    /// Leg layers.
-    #[arg(long, default_value_t = 50)]
-    leg_layers: usize,
-    /// Rays per section (even).
-    #[arg(long, default_value_t = 360)]
-    rays: usize,
-    /// The girth every layer keeps: tape (convex hull) or contour (the paper's rule).
-    #[arg(long, value_enum, default_value_t = Preserve::Tape)]
-    preserve: Preserve,
+    #[command(flatten)]
+    mannequin: MannequinArgs,
     #[command(flatten)]
     export: ExportArgs,
     /// Print measurements.json to standard output instead of the table.
@@ -55,12 +43,7 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     for w in scan.cleaning.warnings().into_iter().chain(topology(&scan.body).warnings()) {
         bar.suspend(|| warn(&file, &w));
     }
-    let options = MannequinOptions {
-        torso_layers: args.torso_layers,
-        leg_layers: args.leg_layers,
-        rays: args.rays,
-        preserve: args.preserve,
-    };
+    let options = args.mannequin.options();
     let result = symmetrize(&scan, &options, |step| {
         bar.inc(1);
         bar.set_message(STEPS[step]);
@@ -90,7 +73,7 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-fn pretty_json(value: &impl serde::Serialize) -> Result<String, Failure> {
+pub(super) fn pretty_json(value: &impl serde::Serialize) -> Result<String, Failure> {
     serde_json::to_string_pretty(value).map_err(Failure::other)
 }
 

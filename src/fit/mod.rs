@@ -25,6 +25,7 @@ pub mod lm;
 pub mod params;
 pub mod priors;
 pub mod robust;
+pub mod verdict;
 
 use correspondences::ScanCloud;
 use glam::DVec3;

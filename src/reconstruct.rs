@@ -1,0 +1,241 @@
+//! Scan to mannequin with pose symmetry first (the paper's whole of section 3): fit the body
+//! model to the scan (eq. 4), give the scan the model's rig, re-pose it symmetric (eq. 3), and
+//! build the mannequin of that ([`crate::pipeline::symmetrize`]). Used by `reconstruct`, `run`
+//! and `demo`.
+
+use crate::body_model::BodyModel;
+use crate::fit::verdict::{self, NotConverged, RegionResidual};
+use crate::fit::{self, Fit, FitError, FitOptions};
+use crate::mannequin::{MannequinError, MannequinOptions};
+use crate::measure::{Girth, Measurements, levels, measure_at};
+use crate::pipeline::{self, Symmetrized};
+use crate::pose_symmetry::{self, PoseOverrides};
+use crate::regions::{BodyRegions, TRACKING_STEP_MM};
+use crate::rig_transfer::{self, RigTransfer};
+use crate::scan::Scan;
+use glam::DVec3;
+use serde::Serialize;
+
+/// How to reconstruct.
+#[derive(Debug, Clone, Default)]
+pub struct ReconstructOptions {
+    /// How to fit the model.
+    pub fit: FitOptions,
+    /// Joint angles set on the symmetric pose.
+    pub pose: PoseOverrides,
+    /// How to build the mannequin.
+    pub mannequin: MannequinOptions,
+}
+
+/// The steps of [`reconstruct`], reported to `progress` as they start: these, then
+/// [`pipeline::STEPS`].
+pub const STEPS: [&str; 3] =
+    ["fitting the body model", "transferring the rig", "re-posing the scan symmetric"];
+
+/// What [`reconstruct`] made.
+#[derive(Debug, Clone)]
+pub struct Reconstruction {
+    /// The fitted model.
+    pub fit: Fit,
+    /// The symmetric pose (one rotation vector per bone).
+    pub symmetric: Vec<DVec3>,
+    /// The fit's residual per body region.
+    pub residuals: Vec<RegionResidual>,
+    /// The scan's skin weights.
+    pub rig: RigTransfer,
+    /// The pose-symmetric scan (same vertices and triangles as the input, moved).
+    pub posed: Scan,
+    /// Its mannequin and measurements.
+    pub result: Symmetrized,
+    /// The input scan's own measurements, where it can be segmented as it stands.
+    pub scan_measurements: Option<Measurements>,
+    /// The fit's wall time (s).
+    pub fit_seconds: f64,
+}
+
+/// Why a reconstruction failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ReconstructError {
+    /// The fit could not run.
+    #[error(transparent)]
+    Fit(#[from] FitError),
+    /// The fit ran but does not match the scan.
+    #[error(transparent)]
+    NotConverged(#[from] NotConverged),
+    /// The pose-symmetric scan gave no mannequin.
+    #[error("the pose-symmetric scan: {0}")]
+    Mannequin(#[from] MannequinError),
+}
+
+/// Reconstructs the mannequin of `scan` (canonical frame) with `model`, calling
+/// `progress(step)` before each step (indices into [`STEPS`] then [`pipeline::STEPS`]).
+pub fn reconstruct(
+    scan: &Scan,
+    model: &BodyModel,
+    options: &ReconstructOptions,
+    mut progress: impl FnMut(usize),
+) -> Result<Reconstruction, ReconstructError> {
+    progress(0);
+    let body = &scan.body;
+    let normals = fit::params::vertex_normals(&body.positions, &body.triangles);
+    let start = std::time::Instant::now();
+    let fitted = fit::fit(model, &body.positions, &normals, &options.fit)?;
+    let fit_seconds = start.elapsed().as_secs_f64();
+    let residuals = verdict::residuals(model, &fitted, &body.positions);
+    verdict::verdict(&residuals)?;
+
+    progress(1);
+    let fitted_mesh = model.mesh(fitted.vertices(model));
+    let bones = model.skeleton.names.len();
+    let rig = rig_transfer::transfer(body, &fitted_mesh, &model.weights, bones);
+
+    progress(2);
+    let mut symmetric = pose_symmetry::symmetric(&fitted.theta, &model.skeleton);
+    options.pose.apply(&mut symmetric, &model.skeleton);
+    let moved = pose_symmetry::repose(
+        &body.positions,
+        &rig.weights,
+        &model.skeleton.parents,
+        &model.joints(&fitted.beta),
+        &fitted.theta,
+        &symmetric,
+        fitted.translation,
+    );
+    let mut posed = scan.clone();
+    posed.body.positions = moved;
+    // The symmetric legs stand a few mm higher or lower: back on the floor, centred again.
+    let floor = posed.body.bounds().map_or(0.0, |b| b.min.z);
+    posed.body.transform(|p| p - DVec3::Z * floor);
+    posed.frame.centre_on_torso(&mut posed.body);
+
+    let result = pipeline::symmetrize(&posed, &options.mannequin, |s| progress(STEPS.len() + s))?;
+    let scan_measurements = BodyRegions::find(body, TRACKING_STEP_MM)
+        .ok()
+        .map(|regions| measure_at(body, &regions, &levels(body, &regions)));
+    Ok(Reconstruction {
+        fit: fitted,
+        symmetric,
+        residuals,
+        rig,
+        posed,
+        result,
+        scan_measurements,
+        fit_seconds,
+    })
+}
+
+/// `measurements.json`: the paper's Table 1 with three columns (the scan as it stood, the
+/// pose-symmetric scan, the mannequin), and the pose-symmetric scan's full comparison.
+#[derive(Debug, Clone, Serialize)]
+pub struct MeasurementsReport<'a> {
+    /// Chest, waist and hip.
+    pub table: Vec<ThreeColumns>,
+    /// The input scan's measurements (`null` when it cannot be segmented as it stands).
+    pub scan: Option<&'a Measurements>,
+    /// Table 1 and Fig. 11 of the pose-symmetric scan and its mannequin.
+    pub pose_symmetric: &'a crate::measure::Comparison,
+}
+
+/// One row of the three-column Table 1.
+#[derive(Debug, Clone, Serialize)]
+pub struct ThreeColumns {
+    /// "chest", "waist" or "hip".
+    pub measure: &'static str,
+    /// The scan as it stood (at its own level), if it could be measured.
+    pub scan: Option<Girth>,
+    /// The pose-symmetric scan.
+    pub pose_symmetric: Girth,
+    /// The mannequin, at the pose-symmetric scan's level.
+    pub mannequin: Girth,
+}
+
+/// `fit.json`: what the fit found and what the symmetric pose is.
+#[derive(Debug, Clone, Serialize)]
+pub struct FitReport {
+    /// Per bone: fitted and symmetric rotation vectors (degrees; see `README.md`, pose).
+    pub joints: Vec<JointAngles>,
+    /// The shape coefficients (standard deviations).
+    pub beta: Vec<f64>,
+    /// The global translation (mm, canonical frame).
+    pub translation_mm: [f64; 3],
+    /// Root mean square distances of the last iteration's pairs.
+    pub residuals: fit::Residuals,
+    /// Per body region, the distance of the model to the scan.
+    pub regions: Vec<RegionResidual>,
+    /// The verdict's threshold on a region's median (mm).
+    pub max_region_median_mm: f64,
+    /// LM iterations.
+    pub iterations: usize,
+    /// The fit's wall time (s).
+    pub seconds: f64,
+    /// Scan vertices whose skin weights were filled from their neighbours.
+    pub rig_filled_vertices: usize,
+}
+
+/// One bone's angles in `fit.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct JointAngles {
+    /// The bone's name.
+    pub name: String,
+    /// The fitted rotation vector (degrees).
+    pub fitted_deg: [f64; 3],
+    /// The symmetric pose's (degrees).
+    pub symmetric_deg: [f64; 3],
+}
+
+impl Reconstruction {
+    /// `measurements.json`.
+    pub fn measurements(&self) -> MeasurementsReport<'_> {
+        let c = &self.result.comparison;
+        let scan = self.scan_measurements.as_ref();
+        let table = c
+            .table
+            .iter()
+            .map(|row| ThreeColumns {
+                measure: row.measure,
+                scan: scan.map(|m| match row.measure {
+                    "chest" => m.chest,
+                    "waist" => m.waist,
+                    _ => m.hip,
+                }),
+                pose_symmetric: row.input,
+                mannequin: row.mannequin,
+            })
+            .collect();
+        MeasurementsReport { table, scan, pose_symmetric: c }
+    }
+
+    /// `fit.json` for a fit with `model`.
+    pub fn fit_report(&self, model: &BodyModel) -> FitReport {
+        let deg = |v: DVec3| (v * 180.0 / std::f64::consts::PI).to_array();
+        let joints = (model.skeleton.names.iter().enumerate())
+            .map(|(b, name)| JointAngles {
+                name: name.clone(),
+                fitted_deg: deg(self.fit.theta[b]),
+                symmetric_deg: deg(self.symmetric[b]),
+            })
+            .collect();
+        FitReport {
+            joints,
+            beta: self.fit.beta.clone(),
+            translation_mm: self.fit.translation.to_array(),
+            residuals: self.fit.residuals,
+            regions: self.residuals.clone(),
+            max_region_median_mm: verdict::MAX_REGION_MEDIAN_MM,
+            iterations: self.fit.iterations,
+            seconds: self.fit_seconds,
+            rig_filled_vertices: self.rig.filled,
+        }
+    }
+
+    /// `rigged.glb`: the input scan with the skeleton at its fitted joints and its weights.
+    pub fn rigged_glb(&self, scan: &Scan, model: &BodyModel) -> Vec<u8> {
+        let joints = self.fit.joints(model);
+        crate::body_model::file::rigged_to_bytes(
+            &scan.body,
+            &self.rig.weights,
+            &model.skeleton,
+            &joints,
+        )
+    }
+}
