@@ -26,11 +26,7 @@ impl Symmetrized {
     /// An export of coordinates as they are ([`crate::scan::format::Placement::AsIs`]) writes the mannequin in the
     /// frame of the scan it was made from, `scan`.
     pub fn mannequin_file(&self, export: &Export, scan: &CanonicalFrame) -> Vec<u8> {
-        let mesh = &self.mannequin.mesh;
-        let (mesh, frame) = match export.placement.file_frame() {
-            Some(frame) => (mesh.clone(), frame),
-            None => (mesh.map_positions(|p| scan.to_scan(p)), scan.file_frame()),
-        };
+        let (mesh, frame) = export.place(&self.mannequin.mesh, scan);
         let carried = CarriedBody {
             frame,
             landmarks: self.mannequin.own_landmarks(),

@@ -69,10 +69,10 @@ pub fn run(args: &ReconstructArgs) -> Result<(), Failure> {
 
     let fit_json = pretty_json(&done.fit_report(&model))?;
     let mut outputs = OutputSet::new();
-    let posed = args.export.placed(&scan, &done.posed.body);
+    let (posed, _) = export.place(&done.posed.body, &done.posed.frame);
     outputs.add(export.file_name("posed"), export.encode(&posed));
-    let mannequin = args.export.placed(&scan, &done.result.mannequin.mesh);
-    outputs.add(export.file_name("mannequin"), export.encode(&mannequin));
+    let mannequin = done.result.mannequin_file(&export, &done.posed.frame);
+    outputs.add(export.file_name("mannequin"), mannequin);
     outputs.add("rigged.glb", done.rigged_glb(&scan, &model));
     let profiles = Profiles::of(&done.result.mannequin, &done.result.comparison.levels);
     outputs.add("profiles.json", pretty_json(&profiles)?);

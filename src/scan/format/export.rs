@@ -9,7 +9,7 @@
 
 use super::Format;
 use crate::mesh::Mesh;
-use crate::scan::frame::{FileFrame, Units};
+use crate::scan::frame::{CanonicalFrame, FileFrame, Units};
 use glam::DVec3;
 
 /// The grid output coordinates are rounded to, in mm (issue 12: 0.001 mm).
@@ -134,6 +134,16 @@ impl Export {
         }
         lines.extend(self.comments.iter().cloned());
         lines
+    }
+
+    /// `mesh`, in the canonical frame of a scan whose frame is `scan`, as it goes into this
+    /// file, with how the file's coordinates map back to the canonical frame: a canonical
+    /// placement keeps the coordinates; coordinates "as they are" go back into the scan's frame.
+    pub fn place(&self, mesh: &Mesh, scan: &CanonicalFrame) -> (Mesh, FileFrame) {
+        match self.placement.file_frame() {
+            Some(frame) => (mesh.clone(), frame),
+            None => (mesh.map_positions(|p| scan.to_scan(p)), scan.file_frame()),
+        }
     }
 
     /// `mesh` encoded: moved into the file's frame, rounded to [`RESOLUTION_MM`], with the
