@@ -27,18 +27,20 @@
 //! runtime, whoever calls [`serve`] (a test process busy with other tests, a host's runtime
 //! in the same process): nothing else runs there, so a loaded caller does not make a healthy
 //! simulated node answer late — as a node's own microcontroller is never held up by the host.
+//! The nodes' watchdogs leave out the pty's own stalls (the kernel holding its bytes on a busy
+//! machine, measured by a [`Canary`]), which no wire has.
 
 use std::future::Future;
 use std::io;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
 use tokio::sync::oneshot;
 
 use crate::bus::can::{BusStats, CanBus, CanKind};
 use crate::bus::candump::CandumpLog;
-use crate::bus::pty::Pty;
+use crate::bus::pty::{Canary, Pty};
 use crate::bus::serial::{DEFAULT_BAUD, SerialLine};
 use crate::bus::slcan::SlcanAdapter;
 use crate::fault::FaultSpec;
@@ -184,6 +186,7 @@ async fn run_form(
 ) -> Result<(), ServeError> {
     let ServeConfig { form, transport, log: log_path, faults, options } = config;
     let pty = Pty::open().map_err(ServeError::Pty)?;
+    let canary = Arc::new(Mutex::new(Canary::open().map_err(ServeError::Pty)?));
     let device = pty.path().to_path_buf();
     let interface = match transport {
         Transport::SerialPty => "serial0",
@@ -200,7 +203,7 @@ async fn run_form(
         Transport::SerialPty => {
             let form = SimulatedForm::on_serial(&form, &faults, &options)?;
             let line = SerialLine::new(pty, DEFAULT_BAUD, &faults, log);
-            let serving = form.serve_serial(line, options.tick, stop);
+            let serving = form.serve_serial(line, options.tick, canary, stop);
             // The caller went away: nothing to serve.
             let Ok(()) = ready.send(Started { device, form, bus: None }) else { return Ok(()) };
             let (line, log) = serving.await;
@@ -209,7 +212,7 @@ async fn run_form(
         }
         Transport::SlcanPty => {
             let bus = Arc::new(CanBus::with(CanKind::CLASSIC_1M, &faults, log));
-            let form = SimulatedForm::on_can(&form, &bus, &faults, &options)?;
+            let form = SimulatedForm::on_can_behind(&form, &bus, &faults, &options, Some(canary))?;
             let adapter = SlcanAdapter::new(pty, &bus);
             let started = Started { device, form, bus: Some(Arc::clone(&bus)) };
             let Ok(()) = ready.send(started) else { return Ok(()) };

@@ -62,6 +62,15 @@ pub const NODE_LOST_AFTER: Duration = Duration::from_millis(timing::NODE_LOST_AF
 /// A serial node that leaves this many polls in a row unanswered is lost: the poll is its
 /// heartbeat, and [`NODE_LOST_AFTER`] is this many heartbeat periods.
 pub const POLLS_LOST: u32 = (timing::NODE_LOST_AFTER_MS / timing::HEARTBEAT_PERIOD_MS) as u32;
+/// How long the whole link may carry nothing before its silence is blamed on the nodes (CAN)
+/// or requests time out regardless: the longest stall of a pseudo-terminal measured on a
+/// loaded 2-core machine (1.3 s, the kernel holding every pty's bytes; see `sim::bus::pty`),
+/// with margin. A single silent node is still found within [`NODE_LOST_AFTER`], since the
+/// others keep talking.
+pub const LINK_STALL_LIMIT: Duration = Duration::from_secs(2);
+/// On CAN, the link carrying nothing at all for this long (two feedback periods of every
+/// node) is the link's stall, not the nodes' silence.
+const LINK_QUIET: Duration = Duration::from_millis(2 * timing::FEEDBACK_PERIOD_MS as u64);
 /// The longest a gap between two wakes of the receive loop counts towards a node's silence:
 /// the loop wakes at least every answer timeout (60 ms on serial), so a longer gap is the
 /// host's own stall (one heartbeat period allows for a busy machine).
@@ -258,6 +267,10 @@ pub struct Session<T> {
     watch_liveness: bool,
     stopped: watch::Receiver<Option<StopCause>>,
     clock: ListeningClock,
+    /// When any node was last heard from, in listening time.
+    heard_any: Duration,
+    /// Packets heard from the described nodes so far.
+    heard_count: u64,
 }
 
 /// How many times a request is sent before its node is reported: the protocol's two
@@ -295,6 +308,8 @@ impl<T: Transport> Session<T> {
             watch_liveness: false,
             stopped,
             clock: ListeningClock::new(),
+            heard_any: Duration::ZERO,
+            heard_count: 0,
         }
     }
 
@@ -354,7 +369,10 @@ impl<T: Transport> Session<T> {
             }
             return;
         };
-        status.heard = Some(self.clock.tick());
+        let now = self.clock.tick();
+        status.heard = Some(now);
+        self.heard_any = now;
+        self.heard_count += 1;
         status.unanswered_polls = 0;
         match packet.message {
             Message::Heartbeat(h) => {
@@ -449,7 +467,10 @@ impl<T: Transport> Session<T> {
             Address::Broadcast => NodeId::MIN,
         };
         let attempts = ATTEMPTS;
-        for _ in 0..attempts {
+        let patience = Instant::now() + LINK_STALL_LIMIT;
+        let mut made = 0;
+        while made < attempts {
+            let heard = self.heard_count;
             self.send(packet).await?;
             let deadline = Instant::now() + answer_timeout(self.link());
             let answer = self
@@ -459,6 +480,12 @@ impl<T: Transport> Session<T> {
                 .await?;
             if let Some(answer) = answer {
                 return Ok(answer.message);
+            }
+            // On CAN, where nodes speak every 20 ms, a wait in which nothing at all was heard
+            // is the link's stall, not this node's silence: it does not count (for a while).
+            let link_stalled = self.link() != Link::Serial && self.heard_count == heard;
+            if !(link_stalled && Instant::now() < patience) {
+                made += 1;
             }
         }
         Err(SessionError::NoAnswer { node: node.get(), request: name, attempts })
@@ -503,8 +530,15 @@ impl<T: Transport> Session<T> {
     fn lost(&mut self) -> Option<SessionError> {
         let now = self.clock.tick();
         let serial = self.link() == Link::Serial;
+        // While the whole link is quiet (on CAN every node speaks every 20 ms, so that is the
+        // link's stall: a busy host's tty layer holding every byte), silence counts only up
+        // to the last time it carried anything — up to a limit. A single silent node is
+        // found as before, since the others keep talking.
+        let quiet = now.saturating_sub(self.heard_any);
+        let until =
+            if quiet > LINK_QUIET && quiet <= LINK_STALL_LIMIT { self.heard_any } else { now };
         self.nodes.iter().find_map(|(&node, status)| {
-            let silent = now.saturating_sub(status.heard?);
+            let silent = until.saturating_sub(status.heard?);
             let node = node.get();
             if serial {
                 (status.unanswered_polls >= POLLS_LOST)
@@ -662,11 +696,15 @@ impl<T: Transport> Session<T> {
         let answer = self
             .request(packet, name, |m| matches!(m, Message::Ack(a) if a.request == Code::Control))
             .await?;
-        self.expect_ok(node, name, answer)
+        self.expect_ok(node, name, answer).await
     }
 
-    fn expect_ok(
-        &self,
+    /// Checks a request's `Ack`; a refusal names the node's state and faults as a fresh
+    /// heartbeat shows them (the last one known may be from before the request: on serial,
+    /// from the poll before it — a node that latched a fault meanwhile would be misreported
+    /// as Disabled).
+    async fn expect_ok(
+        &mut self,
         node: NodeId,
         name: &'static str,
         answer: Message,
@@ -674,6 +712,11 @@ impl<T: Transport> Session<T> {
         match answer {
             Message::Ack(ack) if ack.status == AckStatus::Ok => Ok(()),
             Message::Ack(ack) => {
+                // Only an e-stop outranks the refusal; without a fresh heartbeat the hint
+                // uses the last one.
+                if let Err(stopped @ SessionError::Stopped(_)) = self.refresh().await {
+                    return Err(stopped);
+                }
                 let hint = match self.nodes.get(&node).and_then(|s| s.heartbeat) {
                     Some(h) if !h.faults.is_empty() => format!(
                         " (node {}: {})",
@@ -729,7 +772,7 @@ impl<T: Transport> Session<T> {
                     |m| matches!(m, Message::Ack(a) if a.request == Code::Home),
                 )
                 .await?;
-            self.expect_ok(node, "Home", answer)?;
+            self.expect_ok(node, "Home", answer).await?;
             // The heartbeat that follows shows Homing; forget the old one meanwhile.
             if let Some(status) = self.nodes.get_mut(&node) {
                 status.heartbeat =

@@ -11,7 +11,7 @@ runs=${1:-1}
 hogs=4
 
 # Build first, unloaded: the load is for the tests, not the compiler.
-cargo test --workspace --no-run
+cargo test --workspace --no-fail-fast --no-run
 
 pids=()
 stop_hogs() {
@@ -30,7 +30,7 @@ for run in $(seq 1 "$runs"); do
     done
     echo "== run $run of $runs: cargo test --workspace with $hogs CPU-bound processes"
     start=$(date +%s)
-    if ! cargo test --workspace; then
+    if ! cargo test --workspace --no-fail-fast; then
         echo "== run $run FAILED after $(( $(date +%s) - start )) s"
         exit 1
     fi

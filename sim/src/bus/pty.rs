@@ -9,6 +9,15 @@
 //! clears the mark from time to time ([`Pty::share`]): the device is not exclusive, but the
 //! next host can always open it. Writes wait at most [`WRITE_TIMEOUT`] for a host that does
 //! not read; then the bytes are dropped.
+//!
+//! **The kernel's own stalls.** A pty is not a wire: bytes written to one side reach the other
+//! through the kernel's tty flip buffers, pushed by a shared kernel worker. On a loaded machine
+//! that worker can hold *every* pty's bytes for hundreds of milliseconds (measured on a 2-core
+//! machine running the test suite beside 4 CPU-bound processes: stalls of 150-1300 ms, seen at
+//! the same moments by an unrelated pty pair, while a host's `write` slept in the kernel just
+//! as long). A simulated node that counted that time as host silence would latch a host
+//! timeout that no real wire would cause; a [`Canary`] measures it, so the nodes' watchdogs
+//! can leave it out (see `robot::runners`).
 
 use std::ffi::OsString;
 use std::fs::File;
@@ -21,7 +30,7 @@ use rustix::fs::{Mode, OFlags};
 use rustix::pty::OpenptFlags;
 use rustix::termios::OptionalActions;
 use tokio::io::unix::AsyncFd;
-use tokio::time::{Duration, timeout};
+use tokio::time::{Duration, Instant, timeout};
 
 /// How long a write waits for a host that does not read before dropping the bytes.
 pub const WRITE_TIMEOUT: Duration = Duration::from_millis(100);
@@ -37,23 +46,29 @@ pub struct Pty {
     path: PathBuf,
 }
 
+/// A new pty pair, both sides non-blocking, the slave raw: `(master, slave, slave path)`.
+fn open_pair() -> io::Result<(OwnedFd, OwnedFd, PathBuf)> {
+    let master = rustix::pty::openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY)?;
+    rustix::pty::grantpt(&master)?;
+    rustix::pty::unlockpt(&master)?;
+    let name = rustix::pty::ptsname(&master, Vec::new())?;
+    let path = PathBuf::from(OsString::from_vec(name.into_bytes()));
+    let slave = rustix::fs::open(
+        &path,
+        OFlags::RDWR | OFlags::NOCTTY | OFlags::NONBLOCK | OFlags::CLOEXEC,
+        Mode::empty(),
+    )?;
+    let mut termios = rustix::termios::tcgetattr(&slave)?;
+    termios.make_raw();
+    rustix::termios::tcsetattr(&slave, OptionalActions::Now, &termios)?;
+    rustix::io::ioctl_fionbio(&master, true)?;
+    Ok((master, slave, path))
+}
+
 impl Pty {
     /// Opens a new pair. Must be called within a tokio runtime.
     pub fn open() -> io::Result<Self> {
-        let master = rustix::pty::openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY)?;
-        rustix::pty::grantpt(&master)?;
-        rustix::pty::unlockpt(&master)?;
-        let name = rustix::pty::ptsname(&master, Vec::new())?;
-        let path = PathBuf::from(OsString::from_vec(name.into_bytes()));
-        let slave = rustix::fs::open(
-            &path,
-            OFlags::RDWR | OFlags::NOCTTY | OFlags::NONBLOCK | OFlags::CLOEXEC,
-            Mode::empty(),
-        )?;
-        let mut termios = rustix::termios::tcgetattr(&slave)?;
-        termios.make_raw();
-        rustix::termios::tcsetattr(&slave, OptionalActions::Now, &termios)?;
-        rustix::io::ioctl_fionbio(&master, true)?;
+        let (master, slave, path) = open_pair()?;
         // SAFETY: the `File` owns the master descriptor and lives, unchanged, inside the
         // `AsyncFd` until it is dropped; nothing else closes or replaces it.
         let master = unsafe { AsyncFd::register(File::from(master)) }.map_err(io::Error::from)?;
@@ -103,5 +118,42 @@ impl Pty {
     /// went away).
     pub fn discard_unread(&self) {
         let _ = rustix::termios::tcflush(&self.slave, rustix::termios::QueueSelector::IFlush);
+    }
+}
+
+/// A pty pair of the simulator's own that carries one byte at a time, slave to master, to
+/// measure how long the kernel holds bytes written to a pty (see the module docs).
+#[derive(Debug)]
+pub struct Canary {
+    master: File,
+    slave: File,
+    /// When the byte on its way was written (`None`: none is).
+    in_flight: Option<Instant>,
+}
+
+impl Canary {
+    /// Opens its pair (no tokio runtime needed).
+    pub fn open() -> io::Result<Self> {
+        let (master, slave, _) = open_pair()?;
+        Ok(Self { master: File::from(master), slave: File::from(slave), in_flight: None })
+    }
+
+    /// How long the byte on its way has been held by the kernel at `now` (zero once it
+    /// arrived; then the next one is sent). Never blocks.
+    pub fn lag(&mut self, now: Instant) -> Duration {
+        let mut buf = [0u8; 16];
+        while matches!(self.master.read(&mut buf), Ok(n) if n > 0) {
+            self.in_flight = None;
+        }
+        match self.in_flight {
+            Some(sent) => now.saturating_duration_since(sent),
+            None => {
+                // A failed write (the pair broken) leaves nothing to wait for: no lag.
+                if matches!(self.slave.write(&[0]), Ok(1)) {
+                    self.in_flight = Some(now);
+                }
+                Duration::ZERO
+            }
+        }
     }
 }

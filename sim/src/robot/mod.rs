@@ -40,7 +40,7 @@ use crate::fault::{FaultSpec, FaultSpecError, NodeSchedule};
 use crate::form::{FormDescription, FormError};
 use crate::node::{ActuatorConfig, ActuatorFault, ActuatorState, Node, NodeConfig};
 use node_sim::NodeSim;
-use runners::{SharedNode, lock};
+use runners::{SharedCanary, SharedNode, Stalls, lock};
 
 /// How the simulated form behaves beyond its description.
 #[derive(Clone, Debug, PartialEq)]
@@ -149,13 +149,31 @@ impl SimulatedForm {
         faults: &FaultSpec,
         options: &SimOptions,
     ) -> Result<Self, SimError> {
+        Self::on_can_behind(description, bus, faults, options, None)
+    }
+
+    /// [`SimulatedForm::on_can`] with the host behind a pseudo-terminal whose stalls
+    /// `canary` measures (see `runners`).
+    pub(crate) fn on_can_behind(
+        description: &FormDescription,
+        bus: &CanBus,
+        faults: &FaultSpec,
+        options: &SimOptions,
+        canary: Option<SharedCanary>,
+    ) -> Result<Self, SimError> {
         let nodes = power_on(description, bus.kind().link(), faults, options, bus.origin())?;
         let start = Instant::now();
         let tasks = nodes
             .iter()
             .map(|node| {
-                let task =
-                    runners::node_on_can(Arc::clone(node), bus.attach(), options.tick, start);
+                let stalls = Stalls::new(canary.clone());
+                let task = runners::node_on_can(
+                    Arc::clone(node),
+                    bus.attach(),
+                    options.tick,
+                    start,
+                    stalls,
+                );
                 tokio::spawn(task)
             })
             .collect();
@@ -174,17 +192,20 @@ impl SimulatedForm {
     }
 
     /// Answers the host on `line` until `stop` (or an I/O error), then writes out the line's
-    /// log. Resolves to the line's result and the log's.
+    /// log. Resolves to the line's result and the log's. `canary` measures the stalls of the
+    /// line's pseudo-terminal (see `runners`).
     pub(crate) fn serve_serial(
         &self,
         mut line: SerialLine,
         tick: Duration,
+        canary: SharedCanary,
         stop: oneshot::Receiver<()>,
     ) -> impl Future<Output = (std::io::Result<()>, std::io::Result<()>)> + Send + 'static {
         let nodes = self.nodes.clone();
+        let stalls = Stalls::new(Some(canary));
         async move {
             let result = tokio::select! {
-                result = runners::nodes_on_serial(&nodes, &mut line, tick) => result,
+                result = runners::nodes_on_serial(&nodes, &mut line, tick, stalls) => result,
                 _ = stop => Ok(()),
             };
             (result, line.flush_log())

@@ -1,6 +1,12 @@
 //! The tasks that run nodes on a bus: one task per node on CAN (each node is its own
 //! controller on the bus), one task for all nodes on a serial line (they share the line and
 //! only answer the host).
+//!
+//! **Stalls are not host silence.** A real node's watchdog runs on its own microcontroller
+//! behind a wire that never pauses. Here two things can pause that a wire does not, and the
+//! nodes' watchdogs leave both out ([`Stalls`]): the simulator itself (its process
+//! descheduled on a busy machine), and the pseudo-terminal the host talks through (the
+//! kernel holding its bytes, measured with a [`Canary`]). Each counts beyond [`STALL`].
 
 use std::io;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
@@ -10,41 +16,69 @@ use tokio::time::{Duration, Instant, MissedTickBehavior, interval_at, sleep_unti
 
 use super::node_sim::NodeSim;
 use crate::bus::can::{CanPort, CanSender};
+use crate::bus::pty::Canary;
 use crate::bus::serial::SerialLine;
 
-/// The longest a runner may go between two wakes before the gap counts as the simulator's own
-/// stall (its process descheduled on a busy machine): nodes are ticked every millisecond, so
-/// this is fifty ticks missed.
+/// The longest a runner may go between two wakes, or the kernel may hold a pty's bytes,
+/// before the excess counts as a stall: nodes are ticked every millisecond, so this is fifty
+/// ticks missed (and a sixth of the 300 ms watchdog).
 const STALL: Duration = Duration::from_millis(50);
 
-/// Tells the nodes the time beyond [`STALL`] since `last`, a stall of the simulator, and
-/// returns now.
-fn excuse_stall(nodes: &[SharedNode], last: Instant) -> Instant {
-    let now = Instant::now();
-    let gap = now.saturating_duration_since(last);
-    if gap > STALL {
-        for node in nodes {
-            lock(node).node.excuse(gap - STALL);
+/// The host's pseudo-terminal's [`Canary`], shared by the runners of one served form.
+pub(crate) type SharedCanary = Arc<Mutex<Canary>>;
+
+/// One runner's account of stalls (see the module docs).
+pub(crate) struct Stalls {
+    awake: Instant,
+    canary: Option<SharedCanary>,
+    /// The part of the canary's current lag already excused.
+    excused_lag: Duration,
+}
+
+impl Stalls {
+    pub(crate) fn new(canary: Option<SharedCanary>) -> Self {
+        Self { awake: Instant::now(), canary, excused_lag: Duration::ZERO }
+    }
+
+    /// At a wake of the runner: tells `nodes` the stall since the last wake, the runner's
+    /// own or the link's (the larger: they overlap), beyond [`STALL`].
+    fn excuse(&mut self, nodes: &[SharedNode]) {
+        let now = Instant::now();
+        let own = now.saturating_duration_since(self.awake).saturating_sub(STALL);
+        self.awake = now;
+        let lag = self.canary.as_ref().map_or(Duration::ZERO, |c| lock(c).lag(now));
+        let link_total = lag.saturating_sub(STALL);
+        let link = link_total.saturating_sub(self.excused_lag);
+        self.excused_lag = link_total;
+        let lost = own.max(link);
+        if !lost.is_zero() {
+            for node in nodes {
+                lock(node).node.excuse(lost);
+            }
         }
     }
-    now
 }
 
 /// A node shared by its runner and [`SimulatedForm::state`](super::SimulatedForm::state).
 pub(crate) type SharedNode = Arc<Mutex<NodeSim>>;
 
-pub(crate) fn lock(node: &SharedNode) -> MutexGuard<'_, NodeSim> {
-    node.lock().unwrap_or_else(PoisonError::into_inner)
+pub(crate) fn lock<T>(shared: &Mutex<T>) -> MutexGuard<'_, T> {
+    shared.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
 /// Runs one node on a CAN port: frames in, ticks, frames out (answers of a slow node later).
-pub(crate) async fn node_on_can(node: SharedNode, port: CanPort, tick: Duration, start: Instant) {
+pub(crate) async fn node_on_can(
+    node: SharedNode,
+    port: CanPort,
+    tick: Duration,
+    start: Instant,
+    mut stalls: Stalls,
+) {
     let (sender, mut receiver) = port.split();
     let mut ticker = interval_at(start, tick);
     ticker.set_missed_tick_behavior(MissedTickBehavior::Delay);
     // Answers held back by a `slow` fault, in sending order.
     let mut delayed: Vec<(Instant, Packet)> = Vec::new();
-    let mut awake = Instant::now();
     loop {
         let next_delayed = delayed.first().map(|(at, _)| *at);
         let woken = tokio::select! {
@@ -55,7 +89,7 @@ pub(crate) async fn node_on_can(node: SharedNode, port: CanPort, tick: Duration,
             }
             _ = ticker.tick() => Woken::Tick,
         };
-        awake = excuse_stall(std::slice::from_ref(&node), awake);
+        stalls.excuse(std::slice::from_ref(&node));
         match woken {
             Woken::Frame(None) => return,
             Woken::Frame(Some(frame)) => {
@@ -108,12 +142,12 @@ pub(crate) async fn nodes_on_serial(
     nodes: &[SharedNode],
     line: &mut SerialLine,
     tick: Duration,
+    mut stalls: Stalls,
 ) -> io::Result<()> {
     let mut next_tick = Instant::now();
-    let mut awake = Instant::now();
     loop {
         let request = line.next_request(next_tick).await?;
-        awake = excuse_stall(nodes, awake);
+        stalls.excuse(nodes);
         match request {
             Some(request) => {
                 let now = Instant::now();
