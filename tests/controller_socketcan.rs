@@ -42,7 +42,7 @@ fn a_packet_crosses_a_real_socketcan_interface() {
     };
     let packet = Packet::broadcast(Message::Sync(Sync { duration_ms: 1234 }));
     let received = runtime.block_on(async {
-        sender.send(packet.clone()).await.expect("send");
+        sender.send(packet).await.expect("send");
         tokio::time::timeout(DELIVERY, receiver.recv()).await
     });
     let received =
