@@ -305,7 +305,7 @@ pub fn to_bytes(model: &BodyModel) -> Vec<u8> {
         None,
         Some(json::buffer::Target::ElementArrayBuffer),
     );
-    let (joints_0, weights_0) = b.skin_attributes(&model.weights);
+    let bound = b.skin_attributes(&model.weights);
     let targets: Vec<json::mesh::MorphTarget> = model
         .components
         .iter()
@@ -338,19 +338,7 @@ pub fn to_bytes(model: &BodyModel) -> Vec<u8> {
         extensions: None,
         extras: raw_value(&serde_json::json!({ "targetNames": names })),
         name: Some("body".into()),
-        primitives: vec![json::mesh::Primitive {
-            attributes: BTreeMap::from([
-                (Valid(json::mesh::Semantic::Positions), positions),
-                (Valid(json::mesh::Semantic::Joints(0)), joints_0),
-                (Valid(json::mesh::Semantic::Weights(0)), weights_0),
-            ]),
-            extensions: None,
-            extras: None,
-            indices: Some(indices),
-            material: None,
-            mode: Valid(json::mesh::Mode::Triangles),
-            targets: Some(targets),
-        }],
+        primitives: vec![skinned_triangles(positions, indices, bound, Some(targets))],
         weights: Some(vec![0.0; model.k()]),
     });
     let rest = model.regress_joints(&model.mean).into_iter().map(round_f32).collect::<Vec<_>>();
@@ -405,6 +393,29 @@ pub fn to_bytes(model: &BodyModel) -> Vec<u8> {
     b.finish()
 }
 
+/// One primitive of triangles bound to a skeleton: positions, indices and the skin's
+/// `(JOINTS_0, WEIGHTS_0)` accessors, with the model's morph targets if any.
+fn skinned_triangles(
+    positions: json::Index<json::Accessor>,
+    indices: json::Index<json::Accessor>,
+    (joints_0, weights_0): (json::Index<json::Accessor>, json::Index<json::Accessor>),
+    targets: Option<Vec<json::mesh::MorphTarget>>,
+) -> json::mesh::Primitive {
+    json::mesh::Primitive {
+        attributes: BTreeMap::from([
+            (Valid(json::mesh::Semantic::Positions), positions),
+            (Valid(json::mesh::Semantic::Joints(0)), joints_0),
+            (Valid(json::mesh::Semantic::Weights(0)), weights_0),
+        ]),
+        extensions: None,
+        extras: None,
+        indices: Some(indices),
+        material: None,
+        mode: Valid(json::mesh::Mode::Triangles),
+        targets,
+    }
+}
+
 /// A scan rigged with a skeleton as `.glb` (metres, Y up, facing +Z): the mesh bound as it
 /// stands, with `weights` (at most four bones per vertex), the bones at `joints` (canonical
 /// frame, mm; the fitted pose's joints). Moving a bone's node re-poses the scan (eq. 3).
@@ -428,24 +439,12 @@ pub fn rigged_to_bytes(
     let target = Some(json::buffer::Target::ElementArrayBuffer);
     let count = mesh.triangles.len() * 3;
     let indices = b.accessor(&index_bytes, count, C::U32, T::Scalar, false, None, None, target);
-    let (joints_0, weights_0) = b.skin_attributes(weights);
+    let bound = b.skin_attributes(weights);
     let body_mesh = b.root.push(json::Mesh {
         extensions: None,
         extras: None,
         name: Some("scan".into()),
-        primitives: vec![json::mesh::Primitive {
-            attributes: BTreeMap::from([
-                (Valid(json::mesh::Semantic::Positions), positions),
-                (Valid(json::mesh::Semantic::Joints(0)), joints_0),
-                (Valid(json::mesh::Semantic::Weights(0)), weights_0),
-            ]),
-            extensions: None,
-            extras: None,
-            indices: Some(indices),
-            material: None,
-            mode: Valid(json::mesh::Mode::Triangles),
-            targets: None,
-        }],
+        primitives: vec![skinned_triangles(positions, indices, bound, None)],
         weights: None,
     });
     let at: Vec<DVec3> = joints.iter().map(|&j| round_f32(j)).collect();
