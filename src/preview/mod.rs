@@ -145,10 +145,10 @@ fn extent(mesh: &Mesh, view: &View) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), u| (lo.min(u), hi.max(u)))
 }
 
-/// `preview.png`: `scan` (the body the mannequin was built from, canonical frame) and the
-/// mannequin of `result`, encoded as PNG.
-pub fn preview_png(scan: &Mesh, result: &Symmetrized) -> Vec<u8> {
-    let (width, height, rgb) = preview_rgb(scan, result);
+/// `preview.png`: `body` (the body the mannequin was built from, canonical frame; labelled
+/// `name`, such as "scan" or "pose-symmetric") and the mannequin of `result`, encoded as PNG.
+pub fn preview_png(body: &Mesh, name: &str, result: &Symmetrized) -> Vec<u8> {
+    let (width, height, rgb) = preview_rgb(body, name, result);
     let mut png = Vec::new();
     let encoder = image::codecs::png::PngEncoder::new_with_quality(
         &mut png,
@@ -167,7 +167,7 @@ pub fn preview_png(scan: &Mesh, result: &Symmetrized) -> Vec<u8> {
 }
 
 /// The preview as 8-bit RGB: (width, height, pixels row by row).
-fn preview_rgb(scan: &Mesh, result: &Symmetrized) -> (usize, usize, Vec<u8>) {
+fn preview_rgb(scan: &Mesh, name: &str, result: &Symmetrized) -> (usize, usize, Vec<u8>) {
     let m = &result.mannequin;
     let levels = &result.comparison.levels;
     let heights = [levels.chest, levels.waist, levels.hip];
@@ -213,24 +213,24 @@ fn preview_rgb(scan: &Mesh, result: &Symmetrized) -> (usize, usize, Vec<u8>) {
         if k % 2 == 0 {
             raster::text(&mut rgb, width, (x + PAD_PX as usize, 4), VIEWS[k / 2].name, 1, INK);
         }
-        let body = if k % 2 == 0 { "scan" } else { "mannequin" };
+        let body = if k % 2 == 0 { name } else { "mannequin" };
         raster::text(&mut rgb, width, (x + PAD_PX as usize, 16), body, 1, INK);
         x += w + if k % 2 == 1 { VIEW_GAP_PX } else { 0 };
     }
-    legend(&mut rgb, width, height, result);
+    legend(&mut rgb, width, height, name, result);
     // 64 levels per channel: no visible difference on the shading, a third smaller file.
     rgb.iter_mut().for_each(|v| *v &= POSTERIZE_MASK);
     (width, height, rgb)
 }
 
 /// The legend under the bodies: each level's colour, height and girths.
-fn legend(rgb: &mut [u8], width: usize, height: usize, result: &Symmetrized) {
+fn legend(rgb: &mut [u8], width: usize, height: usize, name: &str, result: &Symmetrized) {
     for (k, (row, colour)) in result.comparison.table.iter().zip(LEVEL_COLOURS).enumerate() {
         let y = height - BOTTOM_PX + 6 + 12 * k;
         let ink = colour.map(|c| (c * 255.0) as u8);
         raster::fill(rgb, width, (PAD_PX as usize, y), (16, 8), ink);
         let words = format!(
-            "{:<5} z {:>4.0} mm   tape girth: scan {:.1} mm, mannequin {:.1} mm ({:+.2})",
+            "{:<5} z {:>4.0} mm   tape girth: {name} {:.1} mm, mannequin {:.1} mm ({:+.2})",
             row.measure, row.z, row.input.tape, row.mannequin.tape, row.tape_change_mm
         );
         raster::text(rgb, width, (PAD_PX as usize + 24, y), &words, 1, INK);
