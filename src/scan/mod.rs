@@ -227,26 +227,16 @@ fn from_file(file: MeshFile, source: &Path, options: &FrameOptions) -> Result<Sc
     let mut scan = match carried {
         None => from_mesh(file.mesh, source, options)?,
         Some(carried) => {
-            let (raw_vertices, raw_triangles) =
-                (file.mesh.positions.len(), file.mesh.triangles.len());
-            let (mut body, cleaning) = clean::clean(file.mesh)
-                .map_err(|error| ScanError::Clean { path: source.into(), error })?;
-            let frame = CanonicalFrame::stated(&carried.frame, &body).map_err(|e| {
-                let error = format!("header line '{}:': frame.{e}", carried::HEADER_KEY);
-                ScanError::Header { path: source.into(), error }
+            let mut scan = cleaned_and_placed(file.mesh, source, |body| {
+                let frame = CanonicalFrame::stated(&carried.frame, body).map_err(|e| {
+                    let error = format!("header line '{}:': frame.{e}", carried::HEADER_KEY);
+                    ScanError::Header { path: source.into(), error }
+                })?;
+                body.transform(|p| frame.to_canonical(p));
+                Ok(frame)
             })?;
-            body.transform(|p| frame.to_canonical(p));
-            let source = source.into();
-            Scan {
-                source,
-                raw_vertices,
-                raw_triangles,
-                cleaning,
-                frame,
-                body,
-                comments: vec![],
-                carried: Some(carried),
-            }
+            scan.carried = Some(carried);
+            scan
         }
     };
     scan.comments = file.comments;
@@ -256,16 +246,28 @@ fn from_file(file: MeshFile, source: &Path, options: &FrameOptions) -> Result<Sc
 /// Cleans `mesh` (as a scanner delivered it) and moves it into the canonical frame; `source`
 /// names it in messages.
 pub fn from_mesh(mesh: Mesh, source: &Path, options: &FrameOptions) -> Result<Scan, ScanError> {
+    cleaned_and_placed(mesh, source, |body| {
+        let mut frame = frame::detect(body, options)
+            .map_err(|error| ScanError::Frame { path: source.into(), error })?;
+        body.transform(|p| frame.to_canonical(p));
+        frame.centre_on_torso(body);
+        Ok(frame)
+    })
+}
+
+/// The one path of every scan: `mesh` cleaned, then moved into the canonical frame by `place`
+/// (which finds the frame, detected or stated, and moves the body into it).
+fn cleaned_and_placed(
+    mesh: Mesh,
+    source: &Path,
+    place: impl FnOnce(&mut Mesh) -> Result<CanonicalFrame, ScanError>,
+) -> Result<Scan, ScanError> {
     let (raw_vertices, raw_triangles) = (mesh.positions.len(), mesh.triangles.len());
     let (mut body, cleaning) =
         clean::clean(mesh).map_err(|error| ScanError::Clean { path: source.into(), error })?;
-    let mut frame = frame::detect(&body, options)
-        .map_err(|error| ScanError::Frame { path: source.into(), error })?;
-    body.transform(|p| frame.to_canonical(p));
-    frame.centre_on_torso(&mut body);
-    let source = source.into();
+    let frame = place(&mut body)?;
     Ok(Scan {
-        source,
+        source: source.into(),
         raw_vertices,
         raw_triangles,
         cleaning,
