@@ -19,6 +19,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use sim::capture::{TriangleSurface, with_noise_and_holes};
 use std::path::Path;
+use std::sync::OnceLock;
 
 /// Bodies (and poses) tried.
 const BODIES: u64 = 10;
@@ -106,12 +107,15 @@ fn nearest(mesh: &Mesh, p: DVec3) -> usize {
         .expect("a body has vertices")
 }
 
-/// A girth change (mm) and the girth's name.
-type Change = (f64, &'static str);
+/// The chest, waist and hip girth changes (mm) of one body between un-posed and posed and
+/// scanned.
+type Changes = [f64; 3];
+/// Their names.
+const GIRTHS: [&str; 3] = ["chest", "waist", "hip"];
 
-/// The largest girth change (mm, and which) of body `seed` between un-posed and posed and
-/// scanned; an error if either does not segment or the scan does not symmetrize.
-fn check(mh: &MakeHuman, seed: u64) -> Result<Change, String> {
+/// The girth changes of body `seed` between un-posed and posed and scanned; an error if either
+/// does not segment or the scan does not symmetrize.
+fn check(mh: &MakeHuman, seed: u64) -> Result<Changes, String> {
     let targets = body_targets(seed);
     let named: Vec<(&str, f64)> = targets.iter().map(|(n, w)| (n.as_str(), *w)).collect();
     let body = mh.shaped(&named).map_err(|e| e.to_string())?;
@@ -157,37 +161,68 @@ fn check(mh: &MakeHuman, seed: u64) -> Result<Change, String> {
     let (_, m) = measured(&scan)?;
     symmetrize(&scan, &MannequinOptions::default(), |_| {})
         .map_err(|e| format!("seed {seed}: symmetrize: {e}"))?;
-    let changes = [
-        (m.chest.tape - truth.chest.tape, "chest"),
-        (m.waist.tape - truth.waist.tape, "waist"),
-        (m.hip.tape - truth.hip.tape, "hip"),
-    ];
-    Ok(changes.into_iter().max_by(|a, b| a.0.abs().total_cmp(&b.0.abs())).expect("three"))
+    Ok([
+        m.chest.tape - truth.chest.tape,
+        m.waist.tape - truth.waist.tape,
+        m.hip.tape - truth.hip.tape,
+    ])
 }
 
-#[test]
-#[ignore = "not yet: 7 of 10 segment and symmetrize; seeds 1, 5 and 7 fail in the mannequin's \
-            layers (`no Torso loop at z = 773 mm`, just above the crotch of a leg held out), \
-            and the worst girth change is +10.55 mm (chest, seed 3)"]
-fn posed_and_scanned_makehuman_bodies_measure_as_un_posed() {
-    let Some(dir) = common::makehuman() else { return };
-    let mh = MakeHuman::load(&dir).expect("the MakeHuman assets load");
-    let results: Vec<(u64, Result<Change, String>)> =
-        (0..BODIES).into_par_iter().map(|seed| (seed, check(&mh, seed))).collect();
+/// Every body's girth changes, computed once for the tests below (a few seconds).
+fn results() -> &'static [(u64, Result<Changes, String>)] {
+    static RESULTS: OnceLock<Vec<(u64, Result<Changes, String>)>> = OnceLock::new();
+    RESULTS.get_or_init(|| {
+        let Some(dir) = common::makehuman() else { return Vec::new() };
+        let mh = MakeHuman::load(&dir).expect("the MakeHuman assets load");
+        let results: Vec<_> =
+            (0..BODIES).into_par_iter().map(|seed| (seed, check(&mh, seed))).collect();
+        for (seed, r) in &results {
+            match r {
+                Ok(d) => println!(
+                    "  seed {seed}: chest {:+.2} mm, waist {:+.2} mm, hip {:+.2} mm",
+                    d[0], d[1], d[2]
+                ),
+                Err(e) => println!("  seed {seed}: {e}"),
+            }
+        }
+        results
+    })
+}
+
+/// Asserts that every body segments and symmetrizes and that the girths `which` (indices into
+/// [`GIRTHS`]) change by at most [`GIRTH_TOLERANCE_MM`]; prints the worst case.
+fn assert_girths_hold(which: &[usize]) {
+    let results = results();
     let failures: Vec<&String> = results.iter().filter_map(|(_, r)| r.as_ref().err()).collect();
     let worst = results
         .iter()
-        .filter_map(|(seed, r)| r.as_ref().ok().map(|c| (seed, c)))
-        .max_by(|a, b| a.1.0.abs().total_cmp(&b.1.0.abs()));
+        .filter_map(|(seed, r)| r.as_ref().ok().map(|d| (seed, d)))
+        .flat_map(|(seed, d)| which.iter().map(move |&g| (seed, d[g], GIRTHS[g])))
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
     println!(
-        "MakeHuman, slightly asymmetric, scanned: {} of {BODIES} segment and symmetrize; worst \
-         girth change {}",
-        BODIES as usize - failures.len(),
-        worst.map_or("-".into(), |(seed, (d, name))| format!("{d:+.2} mm ({name}, seed {seed})")),
+        "MakeHuman, slightly asymmetric, scanned: {} of {} segment and symmetrize; worst {} \
+         change {}",
+        results.len() - failures.len(),
+        results.len(),
+        which.iter().map(|&g| GIRTHS[g]).collect::<Vec<_>>().join("/"),
+        worst.map_or("-".into(), |(seed, d, name)| format!("{d:+.2} mm ({name}, seed {seed})")),
     );
     assert!(failures.is_empty(), "{failures:#?}");
-    for (seed, r) in &results {
-        let (d, name) = r.as_ref().expect("checked above");
+    if let Some((seed, d, name)) = worst {
         assert!(d.abs() <= GIRTH_TOLERANCE_MM, "seed {seed}: {name} changed by {d:+.2} mm");
     }
+}
+
+#[test]
+fn posed_and_scanned_makehuman_bodies_segment_and_keep_waist_and_hip() {
+    assert_girths_hold(&[1, 2]);
+}
+
+#[test]
+#[ignore = "not yet: every body segments and symmetrizes, waist and hip hold, but the chest \
+            (the largest girth just below the armpit) reads 4-17 mm larger posed (seed 1: \
+            +16.6 mm): linear blend skinning swells the torso under a raised arm, by 10 mm \
+            30 mm below the armpit"]
+fn posed_and_scanned_makehuman_bodies_keep_the_chest() {
+    assert_girths_hold(&[0]);
 }

@@ -12,23 +12,31 @@ fn loop_containing(s: &Section, p: DVec2) -> Option<usize> {
     s.loops.iter().position(|l| l.contains(p))
 }
 
-/// Follows the loop containing the previous loop's centroid through `levels` (in the order
-/// given), starting from loop `start` of the first; stops where no loop contains it. Returns
+/// The loop of `s` that continues `prev` (a loop of the neighbouring level): the one holding
+/// its centroid, or, where the centroid lies outside every loop (a loop pinched in the middle,
+/// as the pelvis just above the crotch of a leg held out), the one holding most of its points.
+fn continuing(s: &Section, prev: &Contour) -> Option<usize> {
+    loop_containing(s, prev.centroid()).or_else(|| {
+        let held = |k: usize| prev.points.iter().filter(|&&p| s.loops[k].contains(p)).count();
+        (0..s.loops.len()).map(|k| (held(k), k)).filter(|&(n, _)| n > 0).max().map(|(_, k)| k)
+    })
+}
+
+/// Follows a loop through `levels` (in the order given), starting from loop `start` of the
+/// first, each level's loop [`continuing`] the previous one; stops where none does. Returns
 /// (level index, loop index) pairs.
 fn follow(
     sections: &[Section],
     levels: impl Iterator<Item = usize>,
     start: usize,
 ) -> Vec<(usize, usize)> {
-    let mut out = Vec::new();
-    let mut prev: Option<DVec2> = None;
+    let mut out: Vec<(usize, usize)> = Vec::new();
     for i in levels {
-        let k = match prev {
+        let k = match out.last() {
             None => Some(start),
-            Some(c) => loop_containing(&sections[i], c),
+            Some(&(j, prev)) => continuing(&sections[i], &sections[j].loops[prev]),
         };
         let Some(k) = k else { break };
-        prev = Some(sections[i].loops[k].centroid());
         out.push((i, k));
     }
     out
@@ -53,12 +61,12 @@ fn between(body: &Mesh, below: f64, above: f64) -> Mesh {
 /// The crotch between `below` (the legs apart, their loops around `legs`) and `above` (one
 /// loop around both), by bisection to 0.1 mm, cutting only the part of the body between the
 /// two heights.
-fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, legs: [DVec2; 2]) -> f64 {
+fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, legs: [&Contour; 2]) -> f64 {
     let near = between(body, below, above);
     while above - below > 0.1 {
         let mid = 0.5 * (below + above);
         let s = &sections(&near, &[mid])[0];
-        let [l, r] = legs.map(|c| loop_containing(s, c));
+        let [l, r] = legs.map(|c| continuing(s, c));
         if l.is_some() && l == r { above = mid } else { below = mid }
     }
     above
@@ -191,13 +199,13 @@ pub(super) fn track(
     let (left_k, right_k) =
         if shins[0].centroid().x > shins[1].centroid().x { (0, 1) } else { (1, 0) };
     let mut leg: Vec<[Option<usize>; 2]> = vec![[None, None]; n];
-    let mut apart = [shins[left_k].centroid(), shins[right_k].centroid()];
+    let mut apart = [&shins[left_k], &shins[right_k]];
     let mut crotch_i = None;
     for i in shin..n {
         let found = if i == shin {
             [Some(left_k), Some(right_k)]
         } else {
-            apart.map(|c| loop_containing(&sections[i], c))
+            apart.map(|c| continuing(&sections[i], c))
         };
         match found {
             [Some(l), Some(r)] if l == r => {
@@ -206,7 +214,7 @@ pub(super) fn track(
             }
             [Some(l), Some(r)] => {
                 leg[i] = [Some(l), Some(r)];
-                apart = [sections[i].loops[l].centroid(), sections[i].loops[r].centroid()];
+                apart = [&sections[i].loops[l], &sections[i].loops[r]];
             }
             _ => break,
         }

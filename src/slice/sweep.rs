@@ -238,26 +238,40 @@ fn chain(segments: &[Segment], height: f64) -> Section {
     Section { height, loops: loops.into_iter().map(|(_, c)| c).collect(), bridged_gaps }
 }
 
-/// Joins open chains into loops: the end of a chain is joined to the nearest chain start
-/// (its own start closes it). Each join bridges one gap of the scan with a straight edge.
-fn close_open_chains(mut open: Vec<Vec<DVec2>>) -> Vec<Vec<DVec2>> {
-    let mut loops = Vec::new();
-    while let Some(mut chain) = open.pop() {
-        while let (Some(&end), Some(&own_start)) = (chain.last(), chain.first()) {
-            let nearest = open
-                .iter()
-                .enumerate()
-                .map(|(i, c)| (i, c[0].distance_squared(end)))
-                .min_by(|a, b| a.1.total_cmp(&b.1));
-            match nearest {
-                Some((i, d)) if d < own_start.distance_squared(end) => {
-                    let next = open.swap_remove(i);
-                    chain.extend(next);
-                }
-                _ => break,
-            }
+/// Joins open chains into loops by the shortest bridges first: of all (chain end, chain
+/// start) pairs, its own start included, the closest pair is joined, then the closest of the
+/// rest, and so on; each join bridges one gap of the scan with a straight edge, and the joins
+/// close into loops. Taking the pairs in order of length makes the result independent of the
+/// order the chains were found in, so that nearby planes through the same hole close the same
+/// way (an arm and the torso seen through an armpit hole are joined at every level where the
+/// gap between them is shorter than the hole, never at one level and not at the next).
+fn close_open_chains(open: Vec<Vec<DVec2>>) -> Vec<Vec<DVec2>> {
+    let n = open.len();
+    let mut pairs: Vec<(f64, usize, usize)> = (0..n)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .map(|(i, j)| (open[i][open[i].len() - 1].distance_squared(open[j][0]), i, j))
+        .collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+    let (mut next, mut entered) = (vec![usize::MAX; n], vec![false; n]);
+    for (_, i, j) in pairs {
+        if next[i] == usize::MAX && !entered[j] {
+            next[i] = j;
+            entered[j] = true;
         }
-        loops.push(chain);
+    }
+    let mut taken = vec![false; n];
+    let mut loops = Vec::new();
+    for first in 0..n {
+        let mut points = Vec::new();
+        let mut at = first;
+        while !taken[at] {
+            taken[at] = true;
+            points.extend_from_slice(&open[at]);
+            at = next[at];
+        }
+        if !points.is_empty() {
+            loops.push(points);
+        }
     }
     loops
 }
@@ -354,5 +368,36 @@ mod tests {
         let side = 2.0 * 20.0 * (PI / 32.0).sin();
         let chord = 2.0 * 20.0 * (2.0 * PI / 32.0).sin();
         assert!((s.loops[0].perimeter() - (30.0 * side + chord)).abs() < 1e-9);
+    }
+
+    /// `prism(32, 20)` without the sides (and their cap wedges) `sides`, moved by `dx`.
+    fn holed_prism(sides: &[usize], dx: f64) -> Mesh {
+        let mesh = prism(32, 20.0);
+        let kept = mesh.triangles.iter().enumerate().filter(|(t, _)| !sides.contains(&(t / 4)));
+        let moved = mesh.positions.iter().map(|p| *p + DVec3::X * dx).collect();
+        Mesh::new(moved, kept.map(|(_, t)| *t).collect())
+    }
+
+    #[test]
+    fn chains_close_alike_whatever_order_they_are_found_in() {
+        // `b` is nearly closed (a 1 mm gap); `a`'s end is 5 mm from `b`'s start and 6 mm from
+        // its own. Joining `a` to `b` first would bridge 5 mm and then 7 mm instead of 1 and 6.
+        let pts = |p: &[(f64, f64)]| p.iter().map(|&(x, y)| DVec2::new(x, y)).collect::<Vec<_>>();
+        let a = pts(&[(0.0, 6.0), (-10.0, 6.0), (-10.0, -10.0), (0.0, -10.0), (0.0, 0.0)]);
+        let b = pts(&[(5.0, 0.0), (15.0, 0.0), (15.0, 10.0), (5.0, 10.0), (5.0, 1.0)]);
+        for open in [vec![a.clone(), b.clone()], vec![b, a]] {
+            let mut lengths: Vec<usize> = close_open_chains(open).iter().map(Vec::len).collect();
+            lengths.sort();
+            assert_eq!(lengths, [5, 5]);
+        }
+    }
+
+    #[test]
+    fn a_loop_cut_by_two_holes_is_joined_back_into_one() {
+        let mesh = holed_prism(&[0, 1, 16, 17], 0.0);
+        let s = &sections(&mesh, &[5.0])[0];
+        assert_eq!(s.loops.len(), 1);
+        assert_eq!(s.bridged_gaps, 2);
+        assert!((s.loops[0].signed_area().abs() - PI * 400.0).abs() < 0.15 * PI * 400.0);
     }
 }
