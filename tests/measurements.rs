@@ -180,3 +180,16 @@ fn several_scans_measure_in_parallel_as_csv_and_json() {
     assert!(stderr.contains("broken.ply"), "{stderr}");
     assert_eq!(stdout.lines().count(), 2, "the good scan is still measured: {stdout}");
 }
+
+/// The MakeHuman base body's chest level lies at its armpits, above the bust, where the front
+/// is set farther back than anywhere below: the underbust is still the fold under the bust,
+/// smaller than the chest (it used to be the chest level itself, 850.8 mm both).
+#[test]
+fn the_underbust_is_the_fold_under_the_bust_even_below_a_chest_level_at_the_armpits() {
+    let Some(dir) = common::makehuman() else { return };
+    let scan = dressform::scan::load(&dir.join("base.obj"), &Default::default()).unwrap();
+    let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM).unwrap();
+    let d = dimensions(&scan.body, &regions, &levels(&scan.body, &regions));
+    eprintln!("chest {:.1} mm, underbust {:.1} mm", d.chest_girth_mm, d.underbust_girth_mm);
+    assert!(d.underbust_girth_mm < d.chest_girth_mm, "{d:?}");
+}

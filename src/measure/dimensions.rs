@@ -87,6 +87,10 @@ pub const THIGH_BELOW_CROTCH: f64 = 0.02;
 pub const KNEE_OF_CROTCH: f64 = 0.6;
 /// How far below the chest the underbust is looked for, as a fraction of the stature.
 const UNDERBUST_SPAN: f64 = 0.10;
+/// The least depth of a fold under the bust (mm): the typical scanner's noise (sigma 1 mm,
+/// `sim::capture::Artifacts::typical_scanner`) leaves no dent this deep after smoothing; the
+/// MakeHuman base body's fold is 3 mm deep.
+const MIN_FOLD_MM: f64 = 1.0;
 /// Spacing of the levels searched and of the midline profiles (mm).
 const STEP_MM: f64 = 2.0;
 /// Half-width of the band around the midline whose front- or backmost point a waist length
@@ -137,15 +141,25 @@ pub fn dimensions(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> BodyDi
     let h = m.height;
     let torso = |zs: &[f64]| regions.torso_sections(body, zs);
 
-    // Underbust: the level below the chest where the front is set farthest back.
+    // Underbust: the fold under the bust, the level set farthest back behind the front-most
+    // levels both above it (the bust) and below it (ribs or belly). Merely the level set
+    // farthest back would be the chest level itself where that lies above the bust, at the
+    // armpits (the MakeHuman base body: underbust = chest). A front without a fold keeps
+    // the level set farthest back.
     let under = heights(levels.chest - UNDERBUST_SPAN * h, levels.chest);
-    let under_loops = torso(&under);
-    let front = |c: &Contour| c.points.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
-    let underbust = under_loops
-        .iter()
-        .filter_map(|c| c.as_ref().map(|c| (front(c), c.tape_girth())))
-        .max_by(|a, b| a.0.total_cmp(&b.0))
-        .map_or(0.0, |(_, g)| g);
+    let forward = |c: &Contour| -c.points.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+    let profile: Vec<(f64, f64)> =
+        torso(&under).iter().flatten().map(|c| (forward(c), c.tape_girth())).collect();
+    let most_forward = |levels: &[(f64, f64)]| levels.iter().map(|l| l.0).fold(f64::MIN, f64::max);
+    let fold = (1..profile.len().saturating_sub(1))
+        .map(|k| {
+            let behind = most_forward(&profile[k + 1..]).min(most_forward(&profile[..k]));
+            (behind - profile[k].0, profile[k].1)
+        })
+        .filter(|&(depth, _)| depth > MIN_FOLD_MM)
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    let set_back = profile.iter().min_by(|a, b| a.0.total_cmp(&b.0)).copied();
+    let underbust = fold.or(set_back).map_or(0.0, |(_, g)| g);
 
     let main =
         torso(&[levels.chest, levels.waist, 0.5 * (levels.waist + levels.hip), levels.hip, m.neck]);

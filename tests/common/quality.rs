@@ -9,6 +9,7 @@ use glam::DVec3;
 use robust::{Coord, Coord3D, orient2d, orient3d};
 use rstar::RTree;
 use rstar::primitives::{GeomWithData, Rectangle};
+use std::collections::HashMap;
 
 /// The spacing of the slices the width jump compares (mm), from the definition.
 pub const WIDTH_JUMP_STEP_MM: f64 = 2.0;
@@ -247,4 +248,27 @@ pub fn silhouette_top(mesh: &Mesh, xs: &[f64], ceiling: f64) -> Vec<Option<f64>>
         }
     }
     top
+}
+
+/// The largest angle (degrees) between the normals of two triangles sharing an edge, over the
+/// edges of `mesh` whose two triangles (their corners) `counts` accepts: a crease, seen in a
+/// shaded picture as a line.
+pub fn largest_crease(mesh: &Mesh, counts: impl Fn([DVec3; 3], [DVec3; 3]) -> bool) -> f64 {
+    let mut faces_of_edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            faces_of_edge.entry((a.min(b), a.max(b))).or_default().push(t);
+        }
+    }
+    let normal = |t: usize| mesh.scaled_normal(t).normalize_or_zero();
+    faces_of_edge
+        .values()
+        .filter_map(|faces| match faces[..] {
+            [s, t] if counts(mesh.corners(s), mesh.corners(t)) => {
+                Some(normal(s).dot(normal(t)).clamp(-1.0, 1.0).acos().to_degrees())
+            }
+            _ => None,
+        })
+        .fold(0.0, f64::max)
 }
