@@ -43,6 +43,7 @@ mod slice;
 mod status;
 mod symmetrize;
 
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Parser, Subcommand};
 use dressform::messages;
 use dressform::scan::Scan;
@@ -98,7 +99,7 @@ enum Command {
 #[derive(Debug, Clone, clap::Args)]
 pub struct FrameArgs {
     /// The scan's length unit [default: detected from the body's height].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = units_parser())]
     units: Option<Units>,
     /// The scan's up axis: x, y, z, -x, -y or -z [default: detected].
     #[arg(long, allow_hyphen_values = true)]
@@ -117,6 +118,33 @@ pub struct SmoothArgs {
     smooth: usize,
 }
 
+/// `--units` of a scan: the library's [`Units`] by symbol, each with a line of help (the
+/// library's types know nothing of clap).
+fn units_parser() -> impl TypedValueParser<Value = Units> {
+    let help = |u: Units| match u {
+        Units::M => "Metres",
+        Units::Dm => "Decimetres (MakeHuman)",
+        Units::Cm => "Centimetres",
+        Units::Mm => "Millimetres",
+    };
+    let values = Units::ALL.map(|u| PossibleValue::new(u.symbol()).help(help(u)));
+    PossibleValuesParser::new(values).map(|s| {
+        Units::ALL.into_iter().find(|u| u.symbol() == s).expect("one of the possible values")
+    })
+}
+
+/// `--preserve`: the library's [`Preserve`] by name, each with a line of help.
+fn preserve_parser() -> impl TypedValueParser<Value = Preserve> {
+    let help = |p: Preserve| match p {
+        Preserve::Tape => "The tape girth (the convex hull's perimeter): what a tailor measures",
+        Preserve::Contour => "The contour's own length: the paper's literal rule",
+    };
+    let values = Preserve::ALL.map(|p| PossibleValue::new(p.name()).help(help(p)));
+    PossibleValuesParser::new(values).map(|s| {
+        Preserve::ALL.into_iter().find(|p| p.name() == s).expect("one of the possible values")
+    })
+}
+
 impl FrameArgs {
     fn options(&self) -> FrameOptions {
         FrameOptions { units: self.units, up: self.up, facing: self.facing }
@@ -128,7 +156,7 @@ impl FrameArgs {
 #[derive(Debug, Clone, clap::Args)]
 pub struct ScanFrameArgs {
     /// The scan's length unit [default: detected from the body's height].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = units_parser())]
     scan_units: Option<Units>,
     /// The scan's up axis: x, y, z, -x, -y or -z [default: detected].
     #[arg(long, allow_hyphen_values = true)]
@@ -157,7 +185,7 @@ pub struct MannequinArgs {
     #[arg(long, default_value_t = 360)]
     rays: usize,
     /// The girth every layer keeps: tape (convex hull) or contour (the paper's rule).
-    #[arg(long, value_enum, default_value_t = Preserve::Tape)]
+    #[arg(long, value_parser = preserve_parser(), default_value = Preserve::Tape.name())]
     preserve: Preserve,
 }
 

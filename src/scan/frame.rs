@@ -28,7 +28,7 @@ use std::str::FromStr;
 pub const PERSON_HEIGHT_MM: (f64, f64) = (500.0, 2500.0);
 
 /// A length unit a scan may be stored in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Units {
     /// Metres.
@@ -42,6 +42,19 @@ pub enum Units {
 }
 
 impl Units {
+    /// Every unit, largest first.
+    pub const ALL: [Units; 4] = [Units::M, Units::Dm, Units::Cm, Units::Mm];
+
+    /// The unit's symbol: `m`, `dm`, `cm` or `mm` (as files, JSON and the command line spell it).
+    pub fn symbol(self) -> &'static str {
+        match self {
+            Units::M => "m",
+            Units::Dm => "dm",
+            Units::Cm => "cm",
+            Units::Mm => "mm",
+        }
+    }
+
     /// Millimetres in one unit.
     pub fn mm(self) -> f64 {
         match self {
@@ -54,7 +67,7 @@ impl Units {
 
     /// The unit in which `height` is the height of a standing person (0.5-2.5 m).
     pub fn from_height(height: f64) -> Option<Units> {
-        [Units::M, Units::Dm, Units::Cm, Units::Mm]
+        Units::ALL
             .into_iter()
             .find(|u| (PERSON_HEIGHT_MM.0..=PERSON_HEIGHT_MM.1).contains(&(height * u.mm())))
     }
@@ -62,12 +75,7 @@ impl Units {
 
 impl fmt::Display for Units {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Units::M => "m",
-            Units::Dm => "dm",
-            Units::Cm => "cm",
-            Units::Mm => "mm",
-        })
+        f.write_str(self.symbol())
     }
 }
 

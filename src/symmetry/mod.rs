@@ -17,7 +17,7 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 /// Which girth the final rescale preserves.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Preserve {
     /// The tape girth (the convex hull's perimeter): what a tailor measures. The default.
@@ -28,6 +28,17 @@ pub enum Preserve {
 }
 
 impl Preserve {
+    /// Both rules.
+    pub const ALL: [Preserve; 2] = [Preserve::Tape, Preserve::Contour];
+
+    /// The rule's name: `tape` or `contour` (as JSON and the command line spell it).
+    pub fn name(self) -> &'static str {
+        match self {
+            Preserve::Tape => "tape",
+            Preserve::Contour => "contour",
+        }
+    }
+
     /// The girth of `contour` this rule preserves.
     pub fn girth(self, contour: &Contour) -> f64 {
         match self {
