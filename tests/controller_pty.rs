@@ -5,14 +5,17 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use dressform::controller::session::{LINK_STALL_LIMIT, Session, SessionError};
 use dressform::controller::transport::serial::SerialLine;
 use dressform::controller::transport::slcan::Slcan;
 use dressform::controller::{Connection, DriveOptions, LinkSpec, Transport, drive, status};
 use dressform::setpoints::SetPoints;
-use firmware_protocol::drive::Faults;
+use firmware_protocol::NodeId;
+use firmware_protocol::drive::{DriveCommand, Faults};
 use sim::form::reference;
 use sim::serve::{ServeConfig, Server, Transport as Served, serve};
 use tokio::runtime::Runtime;
+use tokio::time::{Duration, Instant};
 
 /// The reference form served on a pty of `transport` (on its own thread), and a runtime for
 /// the host.
@@ -62,8 +65,7 @@ fn drives_the_form_over_a_serial_pty() {
     // Status over the same pty afterwards: every node identified, Disabled, positions known.
     let connection = Connection::open(&LinkSpec::Serial(server.device_path().into())).unwrap();
     let form = reference();
-    let nodes =
-        runtime.block_on(status(connection, &form, std::time::Duration::from_millis(200))).unwrap();
+    let nodes = runtime.block_on(status(connection, &form, Duration::from_millis(200))).unwrap();
     assert_eq!(nodes.len(), 8);
     for node in &nodes {
         assert!(node.identified && node.problems.is_empty(), "{node:?}");
@@ -98,10 +100,37 @@ fn an_emergency_stop_over_the_serial_pty_reaches_every_node() {
     let (_runtime, server) = start(Served::SerialPty);
     let connection = Connection::open(&LinkSpec::Serial(server.device_path().into())).unwrap();
     dressform::controller::emergency_stop(&connection).unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(100));
+    std::thread::sleep(Duration::from_millis(100));
     for node in server.form().state().nodes {
         assert!(node.faults.contains(Faults::EMERGENCY_STOP), "node {}", node.node.get());
     }
+}
+
+/// Unanswered exchanges while the link carries nothing are excused as a pty stall (up to
+/// `LINK_STALL_LIMIT`); a truly silent node among answering ones is not: liveness reports it
+/// after three polls, and a request to it fails after its attempts, each well before the
+/// limit an excused node would take.
+#[test]
+fn a_silent_serial_node_is_reported_while_the_others_answer() {
+    const ONSET: Duration = Duration::from_secs(2);
+    let mut config = ServeConfig::new(reference(), Served::SerialPty);
+    config.faults = "node2:silent@2s".parse().unwrap();
+    let (runtime, server) = start_with(config);
+    let onset = std::time::Instant::now() + ONSET;
+    let line = SerialLine::open(server.device_path()).unwrap();
+    let mut session = Session::new(line, &reference());
+    runtime.block_on(session.discover()).unwrap();
+    assert!(std::time::Instant::now() < onset, "discovery took over {ONSET:?}");
+    let lost =
+        runtime.block_on(session.wait_until(Instant::now() + 2 * ONSET, |_| false)).unwrap_err();
+    let noticed = onset.elapsed();
+    assert!(matches!(lost, SessionError::NodeUnanswered { node: 2, .. }), "{lost}");
+    assert!(noticed < LINK_STALL_LIMIT, "noticed {noticed:?} after the node fell silent");
+    let asked = std::time::Instant::now();
+    let refused = runtime.block_on(session.control(NodeId::new(2).unwrap(), DriveCommand::Enable));
+    let waited = asked.elapsed();
+    assert!(matches!(refused, Err(SessionError::NoAnswer { node: 2, .. })), "{refused:?}");
+    assert!(waited < LINK_STALL_LIMIT, "no answer reported after {waited:?}");
 }
 
 #[test]

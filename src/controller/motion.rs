@@ -296,7 +296,9 @@ async fn sync<T: Transport>(
 
 /// How many times targets and SYNC are resent when heartbeats do not confirm them.
 const CONFIRM_RETRIES: usize = 3;
-/// How long to wait for heartbeats confirming targets or SYNC (two heartbeat periods).
+/// How long to wait for heartbeats confirming targets or SYNC: two of the nodes' heartbeat
+/// periods (100 ms each, [`firmware_protocol::timing::HEARTBEAT_PERIOD_MS`]) and half of one more for a busy
+/// host.
 const CONFIRM_TIMEOUT: Duration = Duration::from_millis(250);
 
 /// Whether a heartbeat of `n`'s node received after `since` shows its targets staged

@@ -12,6 +12,11 @@
 //!   waits for an answer (so a long series of requests never starves a node's watchdog);
 //! * requests (`IdentifyRequest`, `Control`, `Home`) are addressed and sent up to
 //!   [`ATTEMPTS`] times on no answer; an `Ack` other than Ok is an error naming the node;
+//! * an unanswered request or poll round tells nothing about the nodes when the link itself
+//!   stalled meanwhile — the host's own write slept in the kernel longer than an answer may
+//!   take, or the whole link carried nothing (on serial a poll of another node goes with
+//!   every request, so that a working link always carries something): such an exchange
+//!   does not count, for up to [`LINK_STALL_LIMIT`] in a row ([`Session::silence_counts`]);
 //! * a node that misses three heartbeats in a row is lost. On CAN, where nodes send them
 //!   unasked, that is [`NODE_LOST_AFTER`] of *listening time*: silence counts only while the
 //!   host's receive loop actually runs ([`ListeningClock`]), so a host descheduled by a busy
@@ -271,6 +276,9 @@ pub struct Session<T> {
     heard_any: Duration,
     /// Packets heard from the described nodes so far.
     heard_count: u64,
+    /// Since when unanswered exchanges have been excused as the link's stall (see
+    /// [`Session::silence_counts`]); `None` while the link works.
+    stalled_since: Option<Instant>,
 }
 
 /// How many times a request is sent before its node is reported: the protocol's two
@@ -310,6 +318,7 @@ impl<T: Transport> Session<T> {
             clock: ListeningClock::new(),
             heard_any: Duration::ZERO,
             heard_count: 0,
+            stalled_since: None,
         }
     }
 
@@ -454,8 +463,47 @@ impl<T: Transport> Session<T> {
         }
     }
 
+    /// Whether an exchange that went unanswered counts against the nodes, given the packets
+    /// heard before it began and how long the host's write of it took. It does not while the
+    /// link is stalled (the write slept in the kernel longer than an answer may take, or
+    /// nothing at all was heard meanwhile: on a loaded machine the tty layer can hold every
+    /// pty's bytes for a second, see `sim::bus::pty`), for up to [`LINK_STALL_LIMIT`] in a
+    /// row: a dead link, or a host whose every write sleeps, is still reported.
+    fn silence_counts(&mut self, heard_before: u64, wrote_for: Duration) -> bool {
+        let stalled = wrote_for > answer_timeout(self.link()) || self.heard_count == heard_before;
+        if !stalled {
+            self.stalled_since = None;
+            return true;
+        }
+        let now = Instant::now();
+        let since = *self.stalled_since.get_or_insert(now);
+        now.saturating_duration_since(since) > LINK_STALL_LIMIT
+    }
+
+    /// Sends `packet` and returns how long the write took (it can sleep in the kernel).
+    async fn timed_send(&mut self, packet: Packet) -> Result<Duration, SessionError> {
+        let start = Instant::now();
+        self.send(packet).await?;
+        Ok(start.elapsed())
+    }
+
+    /// On serial, where nodes speak only when asked, polls a node other than `node` (the one
+    /// heard last): its answer shows whether the link carried anything while `node` was
+    /// asked something (see [`Session::silence_counts`]). On CAN the nodes speak unasked.
+    async fn poll_witness(&mut self, node: NodeId) -> Result<(), SessionError> {
+        if self.link() != Link::Serial {
+            return Ok(());
+        }
+        let witness = self.nodes.iter().filter(|(n, _)| **n != node).max_by_key(|(_, s)| s.heard);
+        if let Some((&witness, _)) = witness {
+            let heartbeat = Message::HostHeartbeat(HostHeartbeat { protocol: PROTOCOL_VERSION });
+            self.send(Packet::node(witness, heartbeat)).await?;
+        }
+        Ok(())
+    }
+
     /// Sends `packet` (addressed to `node`) until an answer for which `answered` holds comes
-    /// from it, retrying twice.
+    /// from it, up to [`ATTEMPTS`] times (attempts while the link stalls do not count).
     async fn request(
         &mut self,
         packet: Packet,
@@ -467,11 +515,11 @@ impl<T: Transport> Session<T> {
             Address::Broadcast => NodeId::MIN,
         };
         let attempts = ATTEMPTS;
-        let patience = Instant::now() + LINK_STALL_LIMIT;
         let mut made = 0;
         while made < attempts {
             let heard = self.heard_count;
-            self.send(packet).await?;
+            let wrote_for = self.timed_send(packet).await?;
+            self.poll_witness(node).await?;
             let deadline = Instant::now() + answer_timeout(self.link());
             let answer = self
                 .receive_until(deadline, |p| {
@@ -479,12 +527,10 @@ impl<T: Transport> Session<T> {
                 })
                 .await?;
             if let Some(answer) = answer {
+                self.stalled_since = None;
                 return Ok(answer.message);
             }
-            // On CAN, where nodes speak every 20 ms, a wait in which nothing at all was heard
-            // is the link's stall, not this node's silence: it does not count (for a while).
-            let link_stalled = self.link() != Link::Serial && self.heard_count == heard;
-            if !(link_stalled && Instant::now() < patience) {
+            if self.silence_counts(heard, wrote_for) {
                 made += 1;
             }
         }
@@ -501,19 +547,31 @@ impl<T: Transport> Session<T> {
             self.next_service = now + POLL_PERIOD;
             let heartbeat = Message::HostHeartbeat(HostHeartbeat { protocol: PROTOCOL_VERSION });
             let nodes: Vec<NodeId> = self.nodes.keys().copied().collect();
+            let heard = self.heard_count;
+            let mut slowest_write = Duration::ZERO;
+            let mut unanswered = Vec::new();
             for node in nodes {
                 // A lost poll is noticed by liveness, not retried.
                 let deadline = Instant::now() + answer_timeout(Link::Serial);
-                self.send(Packet::node(node, heartbeat)).await?;
+                slowest_write =
+                    slowest_write.max(self.timed_send(Packet::node(node, heartbeat)).await?);
                 let answer = self
                     .receive_until(deadline, |p| {
                         p.address == Address::Node(node)
                             && matches!(p.message, Message::AllFeedback(_))
                     })
                     .await?;
-                if let (None, Some(status)) = (answer, self.nodes.get_mut(&node)) {
-                    // Any packet from the node starts the count again (see `handle`).
-                    status.unanswered_polls += 1;
+                if answer.is_none() {
+                    unanswered.push(node);
+                }
+            }
+            // A round in which the link stalled tells nothing about the nodes.
+            if !unanswered.is_empty() && self.silence_counts(heard, slowest_write) {
+                for node in unanswered {
+                    if let Some(status) = self.nodes.get_mut(&node) {
+                        // Any packet from the node starts the count again (see `handle`).
+                        status.unanswered_polls += 1;
+                    }
                 }
             }
         } else {

@@ -7,8 +7,14 @@
 //! default); on a pty the mark outlives a host that dies without clearing it (killed with
 //! Ctrl-C), and every later open by a non-root user fails with `EBUSY`. So the simulator
 //! clears the mark from time to time ([`Pty::share`]): the device is not exclusive, but the
-//! next host can always open it. Writes wait at most [`WRITE_TIMEOUT`] for a host that does
-//! not read; then the bytes are dropped.
+//! next host can always open it.
+//!
+//! **Writes never block the simulator and never tear a message.** What the simulator says is
+//! queued whole ([`Pty::queue`]) and written whenever the kernel takes it ([`Pty::flush`]):
+//! a host that reads late, or a kernel that holds the pty's bytes for a while (below), loses
+//! nothing. Only a queue past [`OUTBOX_LIMIT`] — a reader dead for seconds — loses its
+//! oldest whole messages, as a real adapter's buffer overflows; a new session starts with an
+//! empty queue ([`Pty::discard_unread`]).
 //!
 //! **The kernel's own stalls.** A pty is not a wire: bytes written to one side reach the other
 //! through the kernel's tty flip buffers, pushed by a shared kernel worker. On a loaded machine
@@ -19,21 +25,26 @@
 //! timeout that no real wire would cause; a [`Canary`] measures it, so the nodes' watchdogs
 //! can leave it out (see `robot::runners`).
 
+use std::collections::VecDeque;
 use std::ffi::OsString;
 use std::fs::File;
 use std::io::{self, Read, Write};
 use std::os::fd::OwnedFd;
 use std::os::unix::ffi::OsStringExt;
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, PoisonError};
 
 use rustix::fs::{Mode, OFlags};
 use rustix::pty::OpenptFlags;
 use rustix::termios::OptionalActions;
 use tokio::io::unix::AsyncFd;
-use tokio::time::{Duration, Instant, timeout};
+use tokio::time::{Duration, Instant};
 
-/// How long a write waits for a host that does not read before dropping the bytes.
-pub const WRITE_TIMEOUT: Duration = Duration::from_millis(100);
+/// The most the simulator keeps queued for a host that does not read: a reader this far
+/// behind is dead. 256 KiB is over a second of a 1 Mbit/s CAN bus loaded to the full as slcan
+/// text (about 8,000 frames/s of at most 27 bytes), and about ten seconds of the reference
+/// form's own traffic — many times the longest pty stall measured (1.3 s, module docs).
+pub const OUTBOX_LIMIT: usize = 256 * 1024;
 
 /// How often [`Pty::share`] should be called.
 pub const SHARE_EVERY: Duration = Duration::from_millis(200);
@@ -44,6 +55,53 @@ pub struct Pty {
     master: AsyncFd<File>,
     slave: OwnedFd,
     path: PathBuf,
+    outbox: Mutex<Outbox>,
+}
+
+/// Whole messages queued for the host, oldest first; the first may be partly written.
+#[derive(Debug, Default)]
+struct Outbox {
+    messages: VecDeque<Vec<u8>>,
+    /// Bytes of the first message already written.
+    written: usize,
+    /// Bytes queued and not yet written.
+    len: usize,
+}
+
+impl Outbox {
+    fn push(&mut self, bytes: &[u8]) {
+        if bytes.is_empty() {
+            return;
+        }
+        self.len += bytes.len();
+        self.messages.push_back(bytes.to_vec());
+        // Past the limit, drop the oldest messages not begun (a begun one is finished, or
+        // the host would see half a message).
+        while self.len > OUTBOX_LIMIT {
+            let index = usize::from(self.written > 0);
+            let Some(dropped) = self.messages.remove(index) else { break };
+            self.len -= dropped.len();
+        }
+    }
+
+    /// The bytes to write next.
+    fn next(&self) -> &[u8] {
+        self.messages.front().and_then(|m| m.get(self.written..)).unwrap_or_default()
+    }
+
+    /// `n` bytes of [`Outbox::next`] were written.
+    fn advance(&mut self, n: usize) {
+        self.len -= n;
+        self.written += n;
+        if self.messages.front().is_some_and(|m| self.written >= m.len()) {
+            self.messages.pop_front();
+            self.written = 0;
+        }
+    }
+
+    fn clear(&mut self) {
+        *self = Self::default();
+    }
 }
 
 /// A new pty pair, both sides non-blocking, the slave raw: `(master, slave, slave path)`.
@@ -72,7 +130,7 @@ impl Pty {
         // SAFETY: the `File` owns the master descriptor and lives, unchanged, inside the
         // `AsyncFd` until it is dropped; nothing else closes or replaces it.
         let master = unsafe { AsyncFd::register(File::from(master)) }.map_err(io::Error::from)?;
-        Ok(Self { master, slave, path })
+        Ok(Self { master, slave, path, outbox: Mutex::default() })
     }
 
     /// The slave path for the host to open.
@@ -90,22 +148,37 @@ impl Pty {
         }
     }
 
-    /// Writes all of `bytes` for the host; gives up (and returns `TimedOut`) if the host does
-    /// not read for [`WRITE_TIMEOUT`].
-    pub async fn write_all(&self, bytes: &[u8]) -> io::Result<()> {
-        let write = async {
-            let mut rest = bytes;
-            while !rest.is_empty() {
-                let mut guard = self.master.writable().await?;
-                if let Ok(result) = guard.try_io(|fd| fd.get_ref().write(rest)) {
-                    rest = rest.get(result?..).unwrap_or_default();
-                }
+    /// Queues `bytes`, one whole message, for the host (see the module docs); written by
+    /// [`Pty::flush`].
+    pub fn queue(&self, bytes: &[u8]) {
+        self.outbox().push(bytes);
+    }
+
+    /// Whether queued bytes wait for [`Pty::flush`].
+    pub fn has_unsent(&self) -> bool {
+        self.outbox().len > 0
+    }
+
+    /// Writes the queued bytes as the kernel takes them; returns once all are written.
+    /// Cancel-safe: what was written is off the queue, the rest stays queued.
+    pub async fn flush(&self) -> io::Result<()> {
+        while self.has_unsent() {
+            let mut guard = self.master.writable().await?;
+            let written = guard.try_io(|fd| {
+                let mut outbox = self.outbox();
+                let n = fd.get_ref().write(outbox.next())?;
+                outbox.advance(n);
+                Ok(n)
+            });
+            if let Ok(result) = written {
+                result?;
             }
-            Ok(())
-        };
-        timeout(WRITE_TIMEOUT, write).await.unwrap_or_else(|_| {
-            Err(io::Error::new(io::ErrorKind::TimedOut, "the host does not read"))
-        })
+        }
+        Ok(())
+    }
+
+    fn outbox(&self) -> std::sync::MutexGuard<'_, Outbox> {
+        self.outbox.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
     /// Clears an exclusive-use mark a host left on the terminal (see the module docs).
@@ -114,9 +187,10 @@ impl Pty {
         let _ = rustix::termios::ioctl_tiocnxcl(&self.slave);
     }
 
-    /// Drops what was written for the host but not read yet (stale answers of a host that
-    /// went away).
+    /// Drops what was written or queued for the host but not read yet (stale answers of a
+    /// host that went away).
     pub fn discard_unread(&self) {
+        self.outbox().clear();
         let _ = rustix::termios::tcflush(&self.slave, rustix::termios::QueueSelector::IFlush);
     }
 }
@@ -155,5 +229,50 @@ impl Canary {
                 Duration::ZERO
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_full_outbox_drops_its_oldest_whole_messages_and_finishes_a_begun_one() {
+        let mut outbox = Outbox::default();
+        let message = vec![7u8; OUTBOX_LIMIT / 4];
+        outbox.push(&message);
+        outbox.advance(3);
+        for _ in 0..4 {
+            outbox.push(&message);
+        }
+        // One message too many: the oldest not begun went, the begun one stays.
+        assert_eq!(outbox.messages.len(), 4);
+        assert_eq!(outbox.next().len(), message.len() - 3);
+        assert_eq!(outbox.len, OUTBOX_LIMIT - 3);
+        outbox.advance(message.len() - 3);
+        assert_eq!(outbox.next().len(), message.len());
+        assert_eq!(outbox.messages.len(), 3);
+    }
+
+    /// A host that does not read for longer than the kernel buffers (about 20 KB on Linux)
+    /// gets every message later, whole and in order.
+    #[tokio::test]
+    async fn a_late_reader_loses_nothing() {
+        let pty = Pty::open().unwrap();
+        let mut host = std::fs::OpenOptions::new().read(true).open(pty.path()).unwrap();
+        let messages: Vec<Vec<u8>> = (0..64u8).map(|i| vec![i; 1000]).collect();
+        for message in &messages {
+            pty.queue(message);
+        }
+        // The kernel takes part; the rest waits in the queue while the host sleeps.
+        let late = tokio::time::timeout(Duration::from_millis(300), pty.flush()).await;
+        assert!(late.is_err(), "the kernel took 64 KB for a host that did not read");
+        assert!(pty.has_unsent());
+        let reader = std::thread::spawn(move || {
+            let mut got = vec![0u8; 64_000];
+            host.read_exact(&mut got).map(|()| got)
+        });
+        pty.flush().await.unwrap();
+        assert_eq!(reader.join().unwrap().unwrap(), messages.concat());
     }
 }

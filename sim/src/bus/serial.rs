@@ -87,7 +87,7 @@ impl SerialLine {
                 self.pty.share();
                 self.next_share = now + SHARE_EVERY;
             }
-            self.write_due(now).await;
+            self.queue_due(now);
             if now >= until {
                 return Ok(None);
             }
@@ -100,6 +100,7 @@ impl SerialLine {
                     let n = read?;
                     self.take_bytes(&buf[..n]);
                 }
+                written = self.pty.flush(), if self.pty.has_unsent() => written?,
                 () = sleep_until(next) => {}
             }
         }
@@ -168,8 +169,8 @@ impl SerialLine {
         self.answers.push_back(Answer { due, bytes, log });
     }
 
-    /// Writes every answer due by `now`; answers a host does not read are dropped.
-    async fn write_due(&mut self, now: Instant) {
+    /// Queues every answer due by `now` for the host (see [`Pty::queue`]).
+    fn queue_due(&mut self, now: Instant) {
         while self.answers.front().is_some_and(|a| a.due <= now) {
             let Some(answer) = self.answers.pop_front() else { break };
             if let Some(log) = self.log.as_mut() {
@@ -180,10 +181,7 @@ impl SerialLine {
                     }
                 }
             }
-            if !answer.bytes.is_empty() {
-                // A host that stopped reading loses the answer, as on a real line.
-                let _ = self.pty.write_all(&answer.bytes).await;
-            }
+            self.pty.queue(&answer.bytes);
         }
     }
 

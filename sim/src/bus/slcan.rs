@@ -94,16 +94,16 @@ impl SlcanAdapter {
                 read = self.pty.read(&mut buf) => {
                     let n = read?;
                     let answer = self.take_bytes(&buf[..n]);
-                    // A host that stopped reading loses answers, as with a real adapter.
-                    let _ = self.pty.write_all(&answer).await;
+                    self.pty.queue(&answer);
                 }
                 received = self.port.recv_timed() => {
                     let Some(received) = received else { return Ok(()) };
                     if self.channel != Channel::Closed && !received.frame.is_fd() {
                         let line = self.frame_line(&received.frame, received.at);
-                        let _ = self.pty.write_all(line.as_bytes()).await;
+                        self.pty.queue(line.as_bytes());
                     }
                 }
+                written = self.pty.flush(), if self.pty.has_unsent() => written?,
                 _ = share.tick() => self.pty.share(),
             }
         }
