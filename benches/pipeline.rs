@@ -91,7 +91,7 @@ fn benches(c: &mut Criterion) {
             b.iter(|| {
                 let result =
                     symmetrize(&dense, &MannequinOptions::default(), |_| {}).expect("symmetrize");
-                (preview_png(&dense.body, "scan", &result), sections_svg(&dense.body, &result))
+                (preview_png(&[(&dense.body, "scan")], &result), sections_svg(&dense.body, &result))
             })
         },
     );

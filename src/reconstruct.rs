@@ -103,9 +103,11 @@ pub fn reconstruct(
     );
     let mut posed = scan.clone();
     posed.body.positions = moved;
-    // The symmetric legs stand a few mm higher or lower: back on the floor, centred again.
-    let floor = posed.body.bounds().map_or(0.0, |b| b.min.z);
-    posed.body.transform(|p| p - DVec3::Z * floor);
+    // The symmetric legs stand a little higher or lower: the body moved so that its feet stand
+    // where the scan's did, the move recorded in the frame (so `--scan-frame` writes it back
+    // where the scan stood).
+    let drop = feet_drop(model, &fitted, &symmetric);
+    posed.frame.translate(&mut posed.body, DVec3::Z * drop);
     posed.frame.centre_on_torso(&mut posed.body);
 
     let result = pipeline::symmetrize(&posed, &options.mannequin, |s| progress(STEPS.len() + s))?;
@@ -122,6 +124,18 @@ pub fn reconstruct(
         scan_measurements,
         fit_seconds,
     })
+}
+
+/// How far re-posing from `fitted.theta` to `symmetric` lowers the feet (mm; negative when it
+/// raises them): measured on the fitted model, whose soles are whole, not on the scan, whose
+/// soles a scanner cuts at the floor plane (a foot lifted sideways keeps more of its sole, so
+/// the scan's lowest point after re-posing is not a sole's).
+fn feet_drop(model: &BodyModel, fitted: &Fit, symmetric: &[DVec3]) -> f64 {
+    let lowest = |theta: &[DVec3]| {
+        let body = model.posed(&fitted.beta, theta, fitted.translation);
+        body.iter().map(|p| p.z).fold(f64::INFINITY, f64::min)
+    };
+    lowest(&fitted.theta) - lowest(symmetric)
 }
 
 /// `measurements.json`: the paper's Table 1 with three columns (the scan as it stood, the

@@ -203,7 +203,12 @@ fn girths(json: &serde_json::Value, pointer: &str) -> Vec<f64> {
 fn torso_girths(path: &std::path::Path, heights: &[f64], smooth: usize) -> Vec<f64> {
     let mut scan = dressform::scan::load(path, &Default::default()).unwrap();
     scan.body.taubin_smooth(smooth);
-    dressform::measure::central_loops(&scan.body, 0.0, heights)
+    section_girths(&scan.body, heights)
+}
+
+/// The tape girths of `body`'s loop around the midline at `heights`.
+fn section_girths(body: &Mesh, heights: &[f64]) -> Vec<f64> {
+    dressform::measure::central_loops(body, 0.0, heights)
         .into_iter()
         .map(|c| c.map_or(f64::NAN, |c| c.tape_girth()))
         .collect()
@@ -212,6 +217,9 @@ fn torso_girths(path: &std::path::Path, heights: &[f64], smooth: usize) -> Vec<f
 fn read_json(path: &std::path::Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
 }
+
+/// How far the customer stands turned in the yawed cases (degrees, issue 15's range).
+const YAW_DEG: f64 = 20.0;
 
 /// Issue 15's tolerances on the pose-symmetric torso girths against the un-posed body's (mm).
 const GIRTH_TOLERANCE_MM: f64 = 5.0;
@@ -234,7 +242,7 @@ fn reconstruct_makes_posed_makehuman_bodies_pose_symmetric() {
     // Cases 1 and 4 are left out: segmentation (`src/regions/`) finds no torso loop at their
     // crotch (case 4: even of the MakeHuman body posed symmetric; case 1: of the pose-symmetric
     // scan, whose crotch is 3 mm higher than that body's). A limit of the segmentation.
-    for case in [0u64, 2, 3] {
+    for case in [0u64, 2, 3, 5, 6] {
         let mut rng = ChaCha8Rng::seed_from_u64(100 + case);
         let targets = [(SHAPES[case as usize % SHAPES.len()], rng.random_range(0.3..1.0))];
         let body = mh.shaped(&targets).unwrap();
@@ -259,6 +267,10 @@ fn reconstruct_makes_posed_makehuman_bodies_pose_symmetric() {
         let metres_y_up = case % 2 == 1;
         let rest_scan = scan_mesh(&mh.base.skin(&mh.pose(&body, &mean).unwrap()), &mut rng);
         let posed_scan = scan_mesh(&mh.base.skin(&mh.pose(&body, &pose).unwrap()), &mut rng);
+        // From case 5 on the customer also stands turned (issue 15: a yaw of +-20 degrees).
+        let yaw = if case < 5 { 0.0 } else { YAW_DEG.copysign(out) };
+        let turn = glam::DQuat::from_rotation_z(yaw.to_radians());
+        let posed_scan = posed_scan.map_positions(|p| turn * p);
         let (rest_obj, posed_obj) = (tmp.join("rest.obj"), tmp.join("posed.obj"));
         write_obj(&rest_scan, &rest_obj, metres_y_up);
         write_obj(&posed_scan, &posed_obj, metres_y_up);
@@ -281,29 +293,35 @@ fn reconstruct_makes_posed_makehuman_bodies_pose_symmetric() {
             continue;
         }
         eprintln!(
-            "case {case} ({targets:?}, arm{arm} +{arm_deg:.1}, leg{leg} +{leg_deg:.1}):\n{stdout}"
+            "case {case} ({targets:?}, arm{arm} +{arm_deg:.1}, leg{leg} +{leg_deg:.1}, yaw {yaw:+.0}):\n{stdout}"
         );
 
         // Both bodies cut at the un-posed body's chest, waist and hip levels (so that the
-        // girths compare, not where each body's landmarks fall), smoothed alike.
+        // girths compare, not where each body's landmarks fall), smoothed alike; the chest at
+        // the lower of the two bodies' chest levels, each "just below the lower armpit" (a
+        // millimetre higher, the cut can take in an arm).
         let reference = read_json(&rest_out.join("measurements.json"));
-        let levels: Vec<f64> = ["chest", "waist", "hip"]
-            .iter()
-            .map(|m| reference.pointer(&format!("/input/{m}/z_mm")).unwrap().as_f64().unwrap())
-            .collect();
-        let want = torso_girths(&rest_obj, &levels, dressform::mesh::smooth::DEFAULT_PASSES);
-        let got = torso_girths(&out_dir.join("posed.obj"), &levels, 0);
         let measured = read_json(&out_dir.join("measurements.json"));
+        let z = |json: &serde_json::Value, at: &str| json.pointer(at).unwrap().as_f64().unwrap();
+        let mut levels: Vec<f64> = ["chest", "waist", "hip"]
+            .iter()
+            .map(|m| z(&reference, &format!("/input/{m}/z_mm")))
+            .collect();
+        levels[0] = levels[0].min(z(&measured, "/pose_symmetric/input/chest/z_mm"));
+        let want = torso_girths(&rest_obj, &levels, dressform::mesh::smooth::DEFAULT_PASSES);
+        // posed.obj as written (the input scan's canonical frame, its floor kept), not placed
+        // anew: a scanner cuts the soles at the floor, so the re-posed scan's lowest point is
+        // not a floor.
+        let (posed, _) = dressform::scan::read_mesh(&out_dir.join("posed.obj")).unwrap();
+        let got = section_girths(&posed, &levels);
         let table = girths(&measured, "/pose_symmetric/input");
         eprintln!(
             "  at {levels:.0?} mm: un-posed {want:.1?}, pose-symmetric {got:.1?} (own levels {table:.1?})"
         );
-        // Waist and hip only: the chest comes out 8-15 mm small (the re-posed arms pull the
-        // skin below the armpits; issue 15 asks 5 mm: not held yet).
-        let diffs: Vec<f64> = want.iter().zip(&got).map(|(a, b)| (a - b).abs()).skip(1).collect();
+        let diffs: Vec<f64> = want.iter().zip(&got).map(|(a, b)| (a - b).abs()).collect();
         let mean = diffs.iter().sum::<f64>() / diffs.len() as f64;
         if diffs.iter().any(|&d| d > GIRTH_TOLERANCE_MM) || mean > GIRTH_MEAN_TOLERANCE_MM {
-            errors.push(format!("case {case}: waist and hip off by {diffs:.1?} mm"));
+            errors.push(format!("case {case}: chest, waist and hip off by {diffs:.1?} mm"));
         }
 
         let fit = read_json(&out_dir.join("fit.json"));

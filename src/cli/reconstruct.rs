@@ -78,7 +78,10 @@ pub fn run(args: &ReconstructArgs) -> Result<(), Failure> {
     outputs.add("profiles.json", pretty_json(&profiles)?);
     outputs.add("measurements.json", pretty_json(&done.measurements())?);
     outputs.add("fit.json", fit_json.clone());
-    outputs.add("preview.png", preview_png(&done.posed.body, "pose-symmetric", &done.result));
+    outputs.add(
+        "preview.png",
+        preview_png(&[(&scan.body, "scan"), (&done.posed.body, "pose-symmetric")], &done.result),
+    );
     outputs.commit(&args.out).map_err(Failure::other)?;
     bar.finish_and_clear();
     if args.json {

@@ -142,7 +142,7 @@ fn write_outputs(
     let measurements = serde_json::to_vec_pretty(&result.comparison).map_err(Failure::other)?;
     outputs.add("measurements.json", measurements);
     outputs.add("setpoints.json", setpoints.to_json_string());
-    outputs.add("preview.png", preview_png(&scan.body, "scan", result));
+    outputs.add("preview.png", preview_png(&[(&scan.body, "scan")], result));
     outputs.add("sections.svg", sections_svg(&scan.body, result));
     outputs.commit(out).map_err(Failure::other)
 }

@@ -61,7 +61,7 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     let profiles = Profiles::of(&result.mannequin, &result.comparison.levels);
     outputs.add("profiles.json", pretty_json(&profiles)?);
     outputs.add("measurements.json", measurements.clone());
-    outputs.add("preview.png", preview_png(&scan.body, "scan", &result));
+    outputs.add("preview.png", preview_png(&[(&scan.body, "scan")], &result));
     outputs.add("sections.svg", sections_svg(&scan.body, &result));
     outputs.commit(&args.out).map_err(Failure::other)?;
     bar.finish_and_clear();

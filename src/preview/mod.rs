@@ -1,5 +1,6 @@
 //! Pictures of a result, so that every run can be looked at:
-//! - `preview.png` ([`preview_png`]): the scan and the mannequin side by side in front,
+//! - `preview.png` ([`preview_png`]): the scan (and for `reconstruct` its pose-symmetric body)
+//!   and the mannequin side by side in front,
 //!   three-quarter and side views, shaded, with the chest, waist and hip levels drawn around
 //!   both as a tape would lie, and their girths in a legend; software-rendered
 //!   ([`raster`]: a depth buffer, 2×2 supersampling);
@@ -136,6 +137,9 @@ impl Panel<'_> {
     }
 }
 
+/// A body the preview shows: its mesh, vertex normals, colour and level lines.
+type Shown<'a> = (&'a Mesh, &'a [DVec3], Colour, &'a [Option<Contour>]);
+
 /// Horizontal extent of `mesh` seen in `view` (mm along screen right).
 fn extent(mesh: &Mesh, view: &View) -> (f64, f64) {
     let (right, _) = camera(view);
@@ -145,10 +149,11 @@ fn extent(mesh: &Mesh, view: &View) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), u| (lo.min(u), hi.max(u)))
 }
 
-/// `preview.png`: `body` (the body the mannequin was built from, canonical frame; labelled
-/// `name`, such as "scan" or "pose-symmetric") and the mannequin of `result`, encoded as PNG.
-pub fn preview_png(body: &Mesh, name: &str, result: &Symmetrized) -> Vec<u8> {
-    let (width, height, rgb) = preview_rgb(body, name, result);
+/// `preview.png`: `bodies` (canonical frame, each with its label, such as "scan" or
+/// "pose-symmetric"; the last the one the mannequin was built from) and the mannequin of
+/// `result` beside them, encoded as PNG.
+pub fn preview_png(bodies: &[(&Mesh, &str)], result: &Symmetrized) -> Vec<u8> {
+    let (width, height, rgb) = preview_rgb(bodies, result);
     let mut png = Vec::new();
     let encoder = image::codecs::png::PngEncoder::new_with_quality(
         &mut png,
@@ -167,11 +172,12 @@ pub fn preview_png(body: &Mesh, name: &str, result: &Symmetrized) -> Vec<u8> {
 }
 
 /// The preview as 8-bit RGB: (width, height, pixels row by row).
-fn preview_rgb(scan: &Mesh, name: &str, result: &Symmetrized) -> (usize, usize, Vec<u8>) {
+fn preview_rgb(bodies: &[(&Mesh, &str)], result: &Symmetrized) -> (usize, usize, Vec<u8>) {
     let m = &result.mannequin;
     let levels = &result.comparison.levels;
     let heights = [levels.chest, levels.waist, levels.hip];
-    let scan_levels = result.regions.torso_sections(scan, &heights);
+    let body_levels: Vec<Vec<Option<Contour>>> =
+        bodies.iter().map(|(mesh, _)| result.regions.torso_sections(mesh, &heights)).collect();
     let ring_at = |z: f64| {
         m.torso
             .iter()
@@ -179,17 +185,25 @@ fn preview_rgb(scan: &Mesh, name: &str, result: &Symmetrized) -> (usize, usize, 
             .map(|l| Contour { points: l.points.clone() })
     };
     let ring_levels: Vec<Option<Contour>> = heights.iter().map(|&z| ring_at(z)).collect();
-    let (scan_normals, form_normals) =
-        rayon::join(|| vertex_normals(scan), || vertex_normals(&m.mesh));
-    let bounds = scan.bounds().expect("a scan has triangles");
+    let body_normals: Vec<Vec<DVec3>> =
+        bodies.par_iter().map(|(mesh, _)| vertex_normals(mesh)).collect();
+    let form_normals = vertex_normals(&m.mesh);
+    let bounds =
+        crate::mesh::Aabb::around(bodies.iter().flat_map(|(b, _)| b.positions.iter().copied()))
+            .expect("a scan has triangles");
     let scale = BODY_PX / bounds.size().z;
+    // Per view: each body in skin colour with its levels, then the mannequin.
+    let shown: Vec<Shown> = (bodies.iter())
+        .zip(&body_normals)
+        .zip(&body_levels)
+        .map(|(((mesh, _), normals), levels)| (*mesh, &normals[..], SKIN, &levels[..]))
+        .chain([(&m.mesh, &form_normals[..], FORM, &ring_levels[..])])
+        .collect();
+    let names: Vec<&str> = bodies.iter().map(|(_, name)| *name).chain(["mannequin"]).collect();
 
-    let mut panels = Vec::with_capacity(2 * VIEWS.len());
+    let mut panels = Vec::with_capacity(shown.len() * VIEWS.len());
     for view in &VIEWS {
-        for (mesh, normals, colour, levels) in [
-            (scan, &scan_normals, SKIN, &scan_levels[..]),
-            (&m.mesh, &form_normals, FORM, &ring_levels[..]),
-        ] {
+        for &(mesh, normals, colour, levels) in &shown {
             let (lo, hi) = extent(mesh, view);
             let width = ((hi - lo) * scale + 2.0 * PAD_PX).ceil() as usize;
             panels.push(Panel { mesh, normals, colour, levels, heights, view, left_mm: lo, width });
@@ -201,7 +215,7 @@ fn preview_rgb(scan: &Mesh, name: &str, result: &Symmetrized) -> (usize, usize, 
         .map(|p| p.render(scale, bounds.max.z, height).downsample(SUPERSAMPLE))
         .collect();
 
-    // Side by side: the two bodies of a view together, a gap between views.
+    // Side by side: the bodies of a view together, a gap between views.
     let width = rendered.iter().map(|r| r.0).sum::<usize>() + VIEW_GAP_PX * (VIEWS.len() - 1);
     let mut rgb = vec![255u8; width * height * 3];
     let mut x = 0;
@@ -210,14 +224,15 @@ fn preview_rgb(scan: &Mesh, name: &str, result: &Symmetrized) -> (usize, usize, 
             let to = 3 * (row * width + x);
             rgb[to..to + 3 * w].copy_from_slice(&pixels[3 * row * w..3 * (row + 1) * w]);
         }
-        if k % 2 == 0 {
-            raster::text(&mut rgb, width, (x + PAD_PX as usize, 4), VIEWS[k / 2].name, 1, INK);
+        let (view, body) = (k / shown.len(), k % shown.len());
+        if body == 0 {
+            raster::text(&mut rgb, width, (x + PAD_PX as usize, 4), VIEWS[view].name, 1, INK);
         }
-        let body = if k % 2 == 0 { name } else { "mannequin" };
-        raster::text(&mut rgb, width, (x + PAD_PX as usize, 16), body, 1, INK);
-        x += w + if k % 2 == 1 { VIEW_GAP_PX } else { 0 };
+        raster::text(&mut rgb, width, (x + PAD_PX as usize, 16), names[body], 1, INK);
+        x += w + if body + 1 == shown.len() { VIEW_GAP_PX } else { 0 };
     }
-    legend(&mut rgb, width, height, name, result);
+    let built_from = bodies.last().map_or("body", |(_, name)| name);
+    legend(&mut rgb, width, height, built_from, result);
     // 64 levels per channel: no visible difference on the shading, a third smaller file.
     rgb.iter_mut().for_each(|v| *v &= POSTERIZE_MASK);
     (width, height, rgb)

@@ -242,8 +242,14 @@ impl CanonicalFrame {
         };
         let Some(b) = Aabb::around(torso.points.iter().map(|p| p.extend(0.0))) else { return };
         let shift = DVec3::new(0.5 * (b.min.x + b.max.x), 0.5 * (b.min.y + b.max.y), 0.0);
-        body.transform(|p| p - shift);
-        self.translation -= shift;
+        self.translate(body, -shift);
+    }
+
+    /// Moves `body` (already in this frame) by `offset` (mm) and records the move in the
+    /// transform, so that the body still maps back to where the scan stood.
+    pub fn translate(&mut self, body: &mut Mesh, offset: DVec3) {
+        body.transform(|p| p + offset);
+        self.translation += offset;
     }
 
     /// The map from the scan's coordinates to this frame, as a header states it.
