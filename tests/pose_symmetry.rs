@@ -239,10 +239,7 @@ fn reconstruct_makes_posed_makehuman_bodies_pose_symmetric() {
     let dir_guard = tempfile::tempdir().unwrap();
     let tmp = dir_guard.path();
     let mut errors = Vec::new();
-    // Cases 1 and 4 are left out: segmentation (`src/regions/`) finds no torso loop at their
-    // crotch (case 4: even of the MakeHuman body posed symmetric; case 1: of the pose-symmetric
-    // scan, whose crotch is 3 mm higher than that body's). A limit of the segmentation.
-    for case in [0u64, 2, 3, 5, 6] {
+    for case in 0..7u64 {
         let mut rng = ChaCha8Rng::seed_from_u64(100 + case);
         let targets = [(SHAPES[case as usize % SHAPES.len()], rng.random_range(0.3..1.0))];
         let body = mh.shaped(&targets).unwrap();
