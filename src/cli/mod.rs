@@ -118,30 +118,33 @@ pub struct SmoothArgs {
     smooth: usize,
 }
 
-/// `--units` of a scan: the library's [`Units`] by symbol, each with a line of help (the
-/// library's types know nothing of clap).
+/// A parser for one of the library's plain enums (the library knows nothing of clap): each of
+/// `all` is taken by its `name`, and listed in `--help` with its `help` line.
+fn named<T: Copy + Send + Sync + 'static, const N: usize>(
+    all: [T; N],
+    name: fn(T) -> &'static str,
+    help: fn(T) -> &'static str,
+) -> impl TypedValueParser<Value = T> {
+    let values = all.map(|v| PossibleValue::new(name(v)).help(help(v)));
+    PossibleValuesParser::new(values)
+        .map(move |s| all.into_iter().find(|&v| name(v) == s).expect("one of the possible values"))
+}
+
+/// `--units` of a scan: the library's [`Units`] by symbol.
 fn units_parser() -> impl TypedValueParser<Value = Units> {
-    let help = |u: Units| match u {
+    named(Units::ALL, Units::symbol, |u| match u {
         Units::M => "Metres",
         Units::Dm => "Decimetres (MakeHuman)",
         Units::Cm => "Centimetres",
         Units::Mm => "Millimetres",
-    };
-    let values = Units::ALL.map(|u| PossibleValue::new(u.symbol()).help(help(u)));
-    PossibleValuesParser::new(values).map(|s| {
-        Units::ALL.into_iter().find(|u| u.symbol() == s).expect("one of the possible values")
     })
 }
 
-/// `--preserve`: the library's [`Preserve`] by name, each with a line of help.
+/// `--preserve`: the library's [`Preserve`] by name.
 fn preserve_parser() -> impl TypedValueParser<Value = Preserve> {
-    let help = |p: Preserve| match p {
+    named(Preserve::ALL, Preserve::name, |p| match p {
         Preserve::Tape => "The tape girth (the convex hull's perimeter): what a tailor measures",
         Preserve::Contour => "The contour's own length: the paper's literal rule",
-    };
-    let values = Preserve::ALL.map(|p| PossibleValue::new(p.name()).help(help(p)));
-    PossibleValuesParser::new(values).map(|s| {
-        Preserve::ALL.into_iter().find(|p| p.name() == s).expect("one of the possible values")
     })
 }
 
