@@ -238,6 +238,10 @@ fn chain(segments: &[Segment], height: f64) -> Section {
     Section { height, loops: loops.into_iter().map(|(_, c)| c).collect(), bridged_gaps }
 }
 
+/// How many of the nearest chain starts each open chain's end may be bridged to (besides its
+/// own start): a plane crosses a few holes, so a handful is plenty.
+const BRIDGE_CANDIDATES: usize = 8;
+
 /// Joins open chains into loops by the shortest bridges first: of all (chain end, chain
 /// start) pairs, its own start included, the closest pair is joined, then the closest of the
 /// rest, and so on; each join bridges one gap of the scan with a straight edge, and the joins
@@ -247,10 +251,23 @@ fn chain(segments: &[Segment], height: f64) -> Section {
 /// gap between them is shorter than the hole, never at one level and not at the next).
 fn close_open_chains(open: Vec<Vec<DVec2>>) -> Vec<Vec<DVec2>> {
     let n = open.len();
-    let mut pairs: Vec<(f64, usize, usize)> = (0..n)
-        .flat_map(|i| (0..n).map(move |j| (i, j)))
-        .map(|(i, j)| (open[i][open[i].len() - 1].distance_squared(open[j][0]), i, j))
-        .collect();
+    // Each end's nearest starts (its own always among them): memory stays linear in the
+    // number of chains on a mesh shredded into many (a fuzzed or broken file).
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(n * (BRIDGE_CANDIDATES + 1));
+    let mut near: Vec<(f64, usize)> = Vec::with_capacity(n);
+    for (i, chain) in open.iter().enumerate() {
+        let end = chain[chain.len() - 1];
+        near.clear();
+        near.extend(open.iter().enumerate().map(|(j, c)| (end.distance_squared(c[0]), j)));
+        if near.len() > BRIDGE_CANDIDATES {
+            near.select_nth_unstable_by(BRIDGE_CANDIDATES, |a, b| a.0.total_cmp(&b.0));
+            near.truncate(BRIDGE_CANDIDATES);
+        }
+        if !near.iter().any(|&(_, j)| j == i) {
+            near.push((end.distance_squared(chain[0]), i));
+        }
+        pairs.extend(near.iter().map(|&(d, j)| (d, i, j)));
+    }
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
     let (mut next, mut entered) = (vec![usize::MAX; n], vec![false; n]);
     for (_, i, j) in pairs {
@@ -258,6 +275,11 @@ fn close_open_chains(open: Vec<Vec<DVec2>>) -> Vec<Vec<DVec2>> {
             next[i] = j;
             entered[j] = true;
         }
+    }
+    // Ends whose candidates were all taken: the starts left over, in order.
+    let mut free = (0..n).filter(|&j| !entered[j]);
+    for at in next.iter_mut().filter(|at| **at == usize::MAX) {
+        *at = free.next().expect("as many starts left as ends");
     }
     let mut taken = vec![false; n];
     let mut loops = Vec::new();
