@@ -3,7 +3,7 @@
 //! the regions. Each rule is stated on its field and in the README, so that a tailor can
 //! check it with a tape; lengths in millimetres, angles in degrees, heights above the floor.
 
-use super::Levels;
+use super::{Levels, deepest_fold, forward};
 use crate::mesh::Mesh;
 use crate::regions::{BodyRegions, Region};
 use crate::slice::Contour;
@@ -41,7 +41,9 @@ pub struct BodyDimensions {
     /// Shoulder slope: the angle below horizontal of the line from the side of the neck (the
     /// neck section's outermost point at the neck level) to the shoulder point.
     pub shoulder_slope_deg: Bilateral,
-    /// Chest (bust) girth: the largest horizontal tape girth just below the lower armpit.
+    /// Chest (bust) girth: the horizontal tape girth across the bust points, below the lower
+    /// armpit (the chest level of [`Levels`]: the most forward level above the fold under the
+    /// bust, or the nipple line of the standard proportions on a flat chest).
     pub chest_girth_mm: f64,
     /// Underbust girth: the horizontal tape girth where the front is set farthest back
     /// between the chest level and 10% of the stature below it (the fold under the breasts).
@@ -147,19 +149,12 @@ pub fn dimensions(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> BodyDi
     // armpits (the MakeHuman base body: underbust = chest). A front without a fold keeps
     // the level set farthest back.
     let under = heights(levels.chest - UNDERBUST_SPAN * h, levels.chest);
-    let forward = |c: &Contour| -c.points.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
     let profile: Vec<(f64, f64)> =
         torso(&under).iter().flatten().map(|c| (forward(c), c.tape_girth())).collect();
-    let most_forward = |levels: &[(f64, f64)]| levels.iter().map(|l| l.0).fold(f64::MIN, f64::max);
-    let fold = (1..profile.len().saturating_sub(1))
-        .map(|k| {
-            let behind = most_forward(&profile[k + 1..]).min(most_forward(&profile[..k]));
-            (behind - profile[k].0, profile[k].1)
-        })
-        .filter(|&(depth, _)| depth > MIN_FOLD_MM)
-        .max_by(|a, b| a.0.total_cmp(&b.0));
-    let set_back = profile.iter().min_by(|a, b| a.0.total_cmp(&b.0)).copied();
-    let underbust = fold.or(set_back).map_or(0.0, |(_, g)| g);
+    let fronts: Vec<f64> = profile.iter().map(|l| l.0).collect();
+    let set_back = || (0..profile.len()).min_by(|&a, &b| fronts[a].total_cmp(&fronts[b]));
+    let fold = deepest_fold(&fronts, MIN_FOLD_MM).map(|(k, _)| k).or_else(set_back);
+    let underbust = fold.map_or(0.0, |k| profile[k].1);
 
     let main =
         torso(&[levels.chest, levels.waist, 0.5 * (levels.waist + levels.hip), levels.hip, m.neck]);

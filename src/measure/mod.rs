@@ -2,9 +2,15 @@
 //!
 //! Every girth is horizontal and taken on the torso's loop; the tape girth is the convex
 //! hull's perimeter. Levels are found on the input body (canonical frame, mm):
-//! - **chest**: the largest torso tape girth from 10% of the height below the lower armpit up
-//!   to [`CHEST_BELOW_ARMPIT_MM`] below it (bust/chest: maximum girth just below the armpits;
-//!   above the lower armpit a raised arm would join the loop);
+//! - **chest** (bust): at the bust point's level, below the lower armpit (ISO 8559-1 takes the
+//!   chest and bust girths horizontally across the bust points; above the lower armpit a raised
+//!   arm would join the loop). The bust point is the torso's most forward level above the fold
+//!   under the bust, looked for from 10% of the height below the lower armpit up to
+//!   [`CHEST_BELOW_ARMPIT_MM`] below it; a chest with no fold at least [`BUST_FOLD_MM`] deep (a
+//!   flat or male chest, whose nipples a scan does not show) takes the nipple line of the
+//!   standard body proportions, [`BUST_POINT_OF_STATURE`] of the stature. Not the largest
+//!   girth under the armpit: on many bodies that is at the armpit itself, where a raised arm
+//!   swells the torso and the level moves with the armpit;
 //! - **hip**: where the buttocks protrude most (the torso's greatest +Y, i.e. backward, extent)
 //!   between the crotch and 35% of the way up to the armpits; where they protrude within 1 mm of
 //!   that over a range of levels (a flat seat), the middle of that range;
@@ -38,6 +44,15 @@ const LEVEL_STEP_MM: f64 = 2.0;
 /// armpit down to within a few millimetres of the bust point (3 mm on the generator's
 /// customers), so a margin of 1% of the stature (17 mm) missed the chest there.
 const CHEST_BELOW_ARMPIT_MM: f64 = LEVEL_STEP_MM;
+/// How far below the lower armpit the bust point is looked for, as a fraction of the stature.
+const BUST_SPAN: f64 = 0.10;
+/// The least depth of the fold under a bust (mm) for the bust point to be found on the body:
+/// well above a scanner's noise after smoothing and the 1-5 mm fold of MakeHuman's flat and
+/// male chests, whose most forward level wanders by a centimetre with a slight pose.
+pub const BUST_FOLD_MM: f64 = 5.0;
+/// The nipple line as a fraction of the stature (Drillis and Contini's segment proportions,
+/// 0.720 H; MakeHuman's bodies have their bust points at 0.71-0.72 H).
+pub const BUST_POINT_OF_STATURE: f64 = 0.72;
 
 /// A horizontal girth.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -108,9 +123,7 @@ pub fn levels(body: &Mesh, regions: &BodyRegions) -> Levels {
             .map(|&(z, c)| (z, score(c)))
             .max_by(|a, b| a.1.total_cmp(&b.1))
     };
-    let chest =
-        best((armpit - 0.10 * m.height, armpit - CHEST_BELOW_ARMPIT_MM), &|c| c.tape_girth())
-            .map_or(armpit - 0.05 * m.height, |b| b.0);
+    let chest = chest_level(&samples, armpit, m.height);
     let hip_band = (m.crotch, m.crotch + 0.35 * (armpit - m.crotch));
     let back = |c: &Contour| c.points.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max);
     let hip = match best(hip_band, &back) {
@@ -129,6 +142,47 @@ pub fn levels(body: &Mesh, regions: &BodyRegions) -> Levels {
     let interior = narrowest.filter(|&z| z > band.0 + LEVEL_STEP_MM && z < band.1 - LEVEL_STEP_MM);
     let waist = interior.unwrap_or(hip + 0.55 * (chest - hip));
     Levels { chest, waist, hip }
+}
+
+/// The chest level among `samples` (torso loops by ascending height) below the lower `armpit`
+/// of a body `height` tall: see the module documentation.
+fn chest_level(samples: &[(f64, &Contour)], armpit: f64, height: f64) -> f64 {
+    let top = armpit - CHEST_BELOW_ARMPIT_MM;
+    let band: Vec<(f64, f64)> = samples
+        .iter()
+        .filter(|(z, _)| *z >= armpit - BUST_SPAN * height && *z <= top)
+        .map(|&(z, c)| (z, forward(c)))
+        .collect();
+    let fronts: Vec<f64> = band.iter().map(|b| b.1).collect();
+    match deepest_fold(&fronts, BUST_FOLD_MM) {
+        Some((fold, _)) => {
+            let above = &band[fold + 1..];
+            above.iter().max_by(|a, b| a.1.total_cmp(&b.1)).map_or(top, |b| b.0)
+        }
+        None => (BUST_POINT_OF_STATURE * height).min(top),
+    }
+}
+
+/// How far forward (-Y) the front of a torso loop reaches (mm).
+fn forward(c: &Contour) -> f64 {
+    -c.points.iter().map(|p| p.y).fold(f64::INFINITY, f64::min)
+}
+
+/// The deepest fold in a front profile (`forward` of levels by ascending height): the level set
+/// farthest back behind the most forward levels both below and above it, with its depth (mm);
+/// `None` when no level is set back more than `min_depth`.
+fn deepest_fold(forward: &[f64], min_depth: f64) -> Option<(usize, f64)> {
+    let n = forward.len();
+    let mut below = vec![f64::MIN; n];
+    let mut above = vec![f64::MIN; n];
+    for k in 1..n {
+        below[k] = below[k - 1].max(forward[k - 1]);
+        above[n - 1 - k] = above[n - k].max(forward[n - k]);
+    }
+    (0..n)
+        .map(|k| (k, below[k].min(above[k]) - forward[k]))
+        .filter(|&(_, depth)| depth > min_depth)
+        .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
 /// Where the girths of `body` at `levels` are unreliable: a hole in the scan crossing a
