@@ -1,12 +1,13 @@
 //! The measurement set against what the sim generator knows: stature, inside leg and the
-//! girths (torso, neck and legs) measured on its implicit surface at the levels the rules
-//! chose, and the shoulder width it was built with; and `measure` on several scans at once,
+//! girths (torso, neck, legs, and the arms across their axes) measured on its implicit surface
+//! at the levels the rules chose, the shoulder width it was built with and the arm length
+//! between its joints; and `measure` on several scans at once,
 //! as CSV and JSON with the units in the keys.
 
 use crate::common;
 
 use common::{dressform, mesh_of};
-use dressform::measure::{BodyDimensions, dimensions, levels};
+use dressform::measure::{ArmMeasures, BodyDimensions, arms, dimensions, levels};
 use dressform::output::write_atomically;
 use dressform::regions::{BodyRegions, TRACKING_STEP_MM};
 use dressform::scan::format::Format;
@@ -21,11 +22,18 @@ const HEIGHT_MM: f64 = 2.0;
 /// Shoulder width (mm): the generator's acromion is a design point inside a smooth blend;
 /// the shoulder point is the silhouette's corner (see `tests/segmentation.rs`).
 const SHOULDER_MM: f64 = 45.0;
+/// Arm length (mm): measured from the shoulder point (see [`SHOULDER_MM`]) against the
+/// generator's acromion, elbow and wrist joints.
+const ARM_LENGTH_MM: f64 = 45.0;
+/// How far from the generator's wrist joint the narrowest girth above the hand may lie (mm):
+/// the hand's blend (10 mm) thickens the forearm's end, so the narrowest level is just above.
+const WRIST_JOINT_MM: f64 = 30.0;
 
 /// (name, measured, known) for one body.
 fn compare(
     body: &SyntheticBody,
     d: &BodyDimensions,
+    arm: &[Option<ArmMeasures>; 2],
     crotch: f64,
     neck: f64,
 ) -> Vec<(String, f64, f64)> {
@@ -55,6 +63,22 @@ fn compare(
         let pick = |b: &dressform::measure::Bilateral| if left { b.left } else { b.right };
         rows.push((format!("{name} thigh"), pick(&d.thigh_girth_mm), leg(left, thigh_z)));
         rows.push((format!("{name} knee"), pick(&d.knee_girth_mm), leg(left, knee_z)));
+        // Arms: the girths across the axis where the rules took them, on the implicit
+        // surface; the length against the generator's joints (shoulder point to elbow to wrist).
+        let a = arm[usize::from(!left)].as_ref().expect("an A-posed arm is measured");
+        let across = |s: &dressform::measure::ArmSection| {
+            body.girth_across(s.centre.to_array(), s.axis.to_array()).expect("inside the arm")
+        };
+        rows.push((format!("{name} upper arm"), pick(&d.upper_arm_girth_mm), across(&a.upper_arm)));
+        rows.push((format!("{name} wrist"), pick(&d.wrist_girth_mm), across(&a.wrist)));
+        let side = if left { &t.landmarks.left } else { &t.landmarks.right };
+        let [acromion, elbow, wrist] =
+            [side.acromion, side.elbow_joint, side.wrist_joint].map(glam::DVec3::from_array);
+        let length = acromion.distance(elbow) + elbow.distance(wrist);
+        rows.push((format!("{name} arm length"), pick(&d.arm_length_mm), length));
+        // The wrist rule finds the wrist: its axis point near the generator's wrist joint.
+        let wrist_gap = a.wrist.centre.distance(wrist);
+        assert!(wrist_gap < WRIST_JOINT_MM, "{name} wrist taken {wrist_gap:.0} mm from the joint");
     }
     rows
 }
@@ -86,7 +110,7 @@ fn the_measurement_set_matches_what_the_generator_knows() {
                 // Neck to waist: longer than the straight rise, shorter than half the stature.
                 assert!(w > m.neck - lv.waist && w < 0.5 * m.height, "seed {seed}: {w}");
             }
-            compare(&body, &d, m.crotch, m.neck)
+            compare(&body, &d, &arms(&mesh, &regions), m.crotch, m.neck)
                 .into_iter()
                 .map(|(n, a, b)| (seed, n, a, b))
                 .collect::<Vec<_>>()
@@ -104,9 +128,10 @@ fn the_measurement_set_matches_what_the_generator_knows() {
         println!("{name:<15} worst {error:+7.2} mm (seed {seed})");
     }
     for (seed, name, measured, known) in &rows {
-        let tolerance = match name.as_str() {
+        let tolerance = match name.trim_start_matches("left ").trim_start_matches("right ") {
             "stature" | "inside leg" => HEIGHT_MM,
             "shoulder width" => SHOULDER_MM,
+            "arm length" => ARM_LENGTH_MM,
             _ => GIRTH_MM,
         };
         assert!(

@@ -122,6 +122,8 @@ fn flatten(prefix: &str, v: &serde_json::Value, out: &mut Vec<(String, String)>)
             let x = n.as_f64().unwrap_or(f64::NAN);
             out.push((prefix.to_string(), format!("{x:.1}")));
         }
+        // A measurement not taken (an arm raised too high): an empty cell keeps the columns.
+        serde_json::Value::Null => out.push((prefix.to_string(), String::new())),
         _ => {}
     }
 }
@@ -139,12 +141,17 @@ fn print_text(m: &MeasureOut, at: &[f64]) {
     outln!("{}", m.file);
     let g = |name: &str, v: f64| outln!("  {name:<22} {v:7.1} mm");
     let b = |name: &str, v: &dressform::measure::Bilateral, unit: &str| {
-        outln!(
-            "  {name:<22} {:7.1} {unit} left, {:7.1} {unit} right ({:+.1})",
-            v.left,
-            v.right,
-            v.difference
-        )
+        if v.difference.is_nan() {
+            // An arm raised too high to be followed down its loops.
+            outln!("  {name:<22} not measured (left {:.1}, right {:.1} {unit})", v.left, v.right)
+        } else {
+            outln!(
+                "  {name:<22} {:7.1} {unit} left, {:7.1} {unit} right ({:+.1})",
+                v.left,
+                v.right,
+                v.difference
+            )
+        }
     };
     g("stature", d.stature_mm);
     g("neck girth", d.neck_girth_mm);
@@ -169,6 +176,9 @@ fn print_text(m: &MeasureOut, at: &[f64]) {
     b("knee girth", &d.knee_girth_mm, "mm");
     b("calf girth", &d.calf_girth_mm, "mm");
     b("ankle girth", &d.ankle_girth_mm, "mm");
+    b("upper-arm girth", &d.upper_arm_girth_mm, "mm");
+    b("wrist girth", &d.wrist_girth_mm, "mm");
+    b("arm length", &d.arm_length_mm, "mm");
     g("inside leg", d.inside_leg_mm);
     g("back waist length", d.back_waist_length_mm);
     g("front waist length", d.front_waist_length_mm);

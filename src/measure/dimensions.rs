@@ -3,6 +3,7 @@
 //! the regions. Each rule is stated on its field and in the README, so that a tailor can
 //! check it with a tape; lengths in millimetres, angles in degrees, heights above the floor.
 
+use super::arms::{arms, bilateral};
 use super::{Levels, deepest_fold, forward};
 use crate::mesh::Mesh;
 use crate::regions::{BodyRegions, Region};
@@ -22,7 +23,7 @@ pub struct Bilateral {
 }
 
 impl Bilateral {
-    fn new(left: f64, right: f64) -> Bilateral {
+    pub(super) fn new(left: f64, right: f64) -> Bilateral {
         Bilateral { left, right, difference: left - right }
     }
 }
@@ -71,6 +72,16 @@ pub struct BodyDimensions {
     /// Ankle girth: the smallest horizontal tape girth of each leg above the foot (at the
     /// ankle landmark, the legs' narrowest level between 3% and 15% of the stature).
     pub ankle_girth_mm: Bilateral,
+    /// Upper-arm girth: perpendicular to the arm's axis, midway between the armpit and the
+    /// elbow ([`crate::measure::ArmMeasures::upper_arm`]); NaN (null in JSON) for an arm raised too high to
+    /// be followed down its horizontal loops.
+    pub upper_arm_girth_mm: Bilateral,
+    /// Wrist girth: the narrowest girth perpendicular to the arm's axis above the hand
+    /// ([`crate::measure::ArmMeasures::wrist`]); NaN as the upper arm's.
+    pub wrist_girth_mm: Bilateral,
+    /// Arm length: shoulder point to the elbow, then down the arm to the wrist
+    /// ([`crate::measure::ArmMeasures::length`]); NaN as the upper arm's.
+    pub arm_length_mm: Bilateral,
     /// Inside leg length: floor to the crotch (where the legs part).
     pub inside_leg_mm: f64,
     /// Back waist length: from the back of the neck at the neck level down the back's
@@ -180,7 +191,8 @@ pub fn dimensions(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> BodyDi
     let fixed = leg_girths(body, regions, &[m.crotch - THIGH_BELOW_CROTCH * h, knee_z, m.ankle]);
     let calf = leg_girths(body, regions, &heights(m.ankle, knee_z));
     let largest = |pick: fn(&(f64, f64)) -> f64| calf.iter().map(pick).fold(0.0, f64::max);
-    let bilateral = |(l, r): (f64, f64)| Bilateral::new(l, r);
+    let pair = |(l, r): (f64, f64)| Bilateral::new(l, r);
+    let arms = arms(body, regions);
 
     BodyDimensions {
         stature_mm: h,
@@ -194,10 +206,13 @@ pub fn dimensions(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> BodyDi
         high_hip_girth_mm: tape(&main[2]),
         hip_girth_mm: tape(&main[3]),
         hip_height_mm: levels.hip,
-        thigh_girth_mm: bilateral(fixed[0]),
-        knee_girth_mm: bilateral(fixed[1]),
+        thigh_girth_mm: pair(fixed[0]),
+        knee_girth_mm: pair(fixed[1]),
         calf_girth_mm: Bilateral::new(largest(|g| g.0), largest(|g| g.1)),
-        ankle_girth_mm: bilateral(fixed[2]),
+        ankle_girth_mm: pair(fixed[2]),
+        upper_arm_girth_mm: bilateral(&arms, |a| a.upper_arm.girth),
+        wrist_girth_mm: bilateral(&arms, |a| a.wrist.girth),
+        arm_length_mm: bilateral(&arms, |a| a.length),
         inside_leg_mm: m.crotch,
         back_waist_length_mm: midline_length(body, regions, levels.waist, m.neck, false),
         front_waist_length_mm: midline_length(body, regions, levels.waist, m.neck, true),

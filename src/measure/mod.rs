@@ -26,9 +26,11 @@
 //! The mannequin is measured at the same levels: it lives in the same frame, so a height on it
 //! is the same height on the input.
 
+mod arms;
 mod compare;
 mod dimensions;
 
+pub use arms::{ArmMeasures, ArmSection, UPPER_ARM_OF_STATURE, WRIST_FROM_FINGERTIP, arms};
 pub use compare::{Comparison, MirrorRow, TableRow, compare};
 pub use dimensions::{Bilateral, BodyDimensions, KNEE_OF_CROTCH, THIGH_BELOW_CROTCH, dimensions};
 

@@ -61,7 +61,22 @@ pub(crate) fn loop_around(
     (cx, cy): (f64, f64),
     z: f64,
 ) -> Option<Vec<[f64; 2]>> {
-    if body.value_without_arms(DVec3::new(cx, cy, z)) >= 0.0 {
+    let field = |p: DVec3| body.value_without_arms(p);
+    let offsets = loop_in_plane(&field, DVec3::new(cx, cy, z), DVec3::X, DVec3::Y)?;
+    Some(offsets.into_iter().map(|[u, v]| [cx + u, cy + v]).collect())
+}
+
+/// Boundary points of the loop of `field`'s surface in the plane through `centre` spanned by
+/// the orthonormal `u` and `v`, as (u, v) offsets from `centre`: along each of [`RAYS`] rays,
+/// the first point where the surface is left. `None` if `centre` is outside or a ray never
+/// leaves.
+pub(crate) fn loop_in_plane(
+    field: &(dyn Fn(DVec3) -> f64 + Sync),
+    centre: DVec3,
+    u: DVec3,
+    v: DVec3,
+) -> Option<Vec<[f64; 2]>> {
+    if field(centre) >= 0.0 {
         return None;
     }
     (0..RAYS)
@@ -69,7 +84,7 @@ pub(crate) fn loop_around(
         .map(|i| {
             let angle = i as f64 / RAYS as f64 * std::f64::consts::TAU;
             let (s, c) = angle.sin_cos();
-            let at = |r: f64| body.value_without_arms(DVec3::new(cx + r * c, cy + r * s, z));
+            let at = |r: f64| field(centre + (u * c + v * s) * r);
             let mut r = 0.0;
             let mut value = at(r);
             while r < RAY_REACH {
@@ -79,13 +94,22 @@ pub(crate) fn loop_around(
                 let next_value = at(next);
                 if next_value >= 0.0 {
                     let rb = bisect(at, r, next);
-                    return Some([cx + rb * c, cy + rb * s]);
+                    return Some([rb * c, rb * s]);
                 }
                 (r, value) = (next, next_value);
             }
             None
         })
         .collect()
+}
+
+/// The tape girth of the body's section (arms included) by the plane through `centre`
+/// perpendicular to `axis`, around `centre`: a limb's girth across its axis.
+pub(crate) fn tape_girth_across(body: &ImplicitBody, centre: DVec3, axis: DVec3) -> Option<f64> {
+    let axis = axis.normalize();
+    let u = axis.any_orthonormal_vector();
+    let field = |p: DVec3| body.value(p);
+    loop_in_plane(&field, centre, u, axis.cross(u)).map(|pts| perimeter(&convex_hull(&pts)))
 }
 
 /// Perimeter of the closed polygon `pts`.

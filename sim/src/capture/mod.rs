@@ -71,6 +71,18 @@ impl SyntheticBody {
         calibration::tape_girth_around(&self.implicit, (inside[0], inside[1]), z)
     }
 
+    /// The tape girth (mm) of the section (arms included) by the plane through `centre`
+    /// perpendicular to `axis`, around `centre` (360 rays in the plane, their first exits,
+    /// hulled): a limb's girth across its axis, measured on the implicit surface. `None` if
+    /// `centre` is not inside.
+    pub fn girth_across(&self, centre: [f64; 3], axis: [f64; 3]) -> Option<f64> {
+        calibration::tape_girth_across(
+            &self.implicit,
+            glam::DVec3::from_array(centre),
+            glam::DVec3::from_array(axis),
+        )
+    }
+
     /// A point on the axis of the leg on the subject's left (`left`) or right side at height
     /// `z` (on the line from the hip joint to the ankle joint): inside the leg below the crotch.
     pub fn leg_axis_at(&self, left: bool, z: f64) -> [f64; 2] {
