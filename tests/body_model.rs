@@ -258,10 +258,10 @@ fn held_out_bodies_project_onto_the_model_within_millimetres() {
         "held-out projection: mean vertex error {mean:.2} mm (worst body {:.2}), max {worst:.2} mm",
         means.iter().copied().fold(0.0, f64::max)
     );
-    // Issue 14 asks for a max of 15 mm; 15 components leave local torso details of the 30
-    // regional sliders and 22 body shapes (bust, belly, pectorals, buttocks) at up to ~24 mm.
-    // Held to what the model does today so that it cannot get worse unnoticed.
-    assert!(mean <= 5.0 && worst <= 25.0, "mean {mean}, max {worst}");
+    // Issue 14: mean <= 5 mm, max <= 15 mm. The held-out bodies come from the build's own
+    // distribution (`population`); the largest errors are local details no 15 components hold
+    // (a slack belly, pectorals, the corners of MakeHuman's macro blend).
+    assert!(mean <= 5.0 && worst <= 15.0, "mean {mean}, max {worst}");
 }
 
 #[test]
