@@ -12,15 +12,17 @@
 //!
 //! ```no_run
 //! use dressform::{body_model::BodyModel, fit};
-//! # let (points, normals): (Vec<glam::DVec3>, Vec<glam::DVec3>) = (vec![], vec![]);
+//! # let scan = dressform::mesh::Mesh::new(vec![], vec![]);
 //! let model = BodyModel::builtin();
-//! let fitted = fit::fit(&model, &points, &normals, &fit::FitOptions::default())?;
+//! let points = fit::ScanPoints::of_mesh(&scan);
+//! let fitted = fit::fit(&model, &points, &fit::FitOptions::default())?;
 //! println!("{} iterations, beta {:?}", fitted.iterations, fitted.beta);
 //! # Ok::<(), dressform::fit::FitError>(())
 //! ```
 
 pub mod arm_starts;
 pub mod correspondences;
+pub mod joint_limits;
 pub mod lm;
 pub mod params;
 pub mod priors;
@@ -28,6 +30,7 @@ pub mod robust;
 pub mod verdict;
 
 use correspondences::ScanCloud;
+pub use correspondences::ScanPoints;
 use glam::DVec3;
 use params::{Params, Prepared, vertex_normals};
 
@@ -151,19 +154,20 @@ pub enum FitError {
 /// model triangle's worth of surface).
 pub const MIN_POINTS: usize = 1000;
 
-/// Fits `model` to scan points (canonical frame: mm, Z up, facing -Y) with unit outward
-/// `normals`, starting from the mean model at rest placed on the scan's bounding box.
+/// Fits `model` to `scan` (canonical frame: mm, Z up, facing -Y), starting from the mean model
+/// at rest placed on the scan's bounding box.
 pub fn fit(
     model: &crate::body_model::BodyModel,
-    points: &[DVec3],
-    normals: &[DVec3],
+    scan: &ScanPoints,
     options: &FitOptions,
 ) -> Result<Fit, FitError> {
-    if points.len() != normals.len() {
+    let (points, normals) = (scan.points, &scan.normals);
+    if points.len() != normals.len() || points.len() != scan.on_hole_boundary.len() {
         return Err(FitError::Input(format!(
-            "{} points but {} normals",
+            "{} points, {} normals and {} hole-boundary flags",
             points.len(),
-            normals.len()
+            normals.len(),
+            scan.on_hole_boundary.len()
         )));
     }
     if points.len() < MIN_POINTS {
@@ -174,7 +178,7 @@ pub fn fit(
     }
     let prep = Prepared::new(model);
     let stride = (1.0 / options.sample_fraction.clamp(1e-3, 1.0)).round() as usize;
-    let scan = ScanCloud::new(points, normals, stride);
+    let cloud = ScanCloud::new(scan, stride);
     let centre = |p: &[DVec3]| {
         let b = crate::mesh::Aabb::around(p.iter().copied()).expect("not empty");
         (b.min + b.max) / 2.0
@@ -185,13 +189,13 @@ pub fn fit(
     for (s, stage) in options.stages.iter().enumerate() {
         let active = active(&prep, stage.bones);
         if stage.bones != Bones::Global && s > 0 && options.stages[s - 1].bones == Bones::Global {
-            params = arm_starts::best(&prep, &scan, params, stage.sigma_mm);
+            params = arm_starts::best(&prep, &cloud, params, stage.sigma_mm);
         }
         let mut lambda = lm::LAMBDA_START;
         for _ in 0..stage.iterations {
             let posed = prep.pose(&params);
             let normals = vertex_normals(&posed.vertices, &model.triangles);
-            let data = correspondences::gather(&scan, &posed.vertices, &normals, stage.sigma_mm);
+            let data = correspondences::gather(&cloud, &posed.vertices, &normals, stage.sigma_mm);
             let step = lm::iterate(&prep, &data, &params, &posed, &active, lambda);
             iterations += 1;
             params = step.params;
