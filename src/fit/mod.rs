@@ -4,8 +4,10 @@
 //!
 //! Robust ICP with a Levenberg-Marquardt step ([`lm`]): closest points both ways
 //! ([`correspondences`]), point-to-plane plus a little point-to-point, pairs rejected where the
-//! normals disagree, Geman-McClure weights ([`robust`]) annealed coarse to fine, a prior on
-//! beta and a weak one on the angles ([`priors`]). Coarse to fine in the unknowns as well
+//! normals disagree or the scan point lies on a hole's boundary, Geman-McClure weights
+//! ([`robust`]) annealed coarse to fine; eq. 4's regularisers ([`priors`]): a prior on beta,
+//! joint limits ([`joint_limits`]), a smoothness prior along the spine, a weak pull of the
+//! angles to rest and a stiffer one on the clavicles. Coarse to fine in the unknowns as well
 //! ([`STAGES`]): global placement and shape, then spine, shoulders, arms and hips, then every
 //! bone. Before the limbs are freed the arms try several abductions ([`arm_starts`]) against
 //! the local minimum of an arm matched to the torso.
