@@ -1,6 +1,8 @@
 //! Benchmarks of the scan side on the realistic MakeHuman body, subdivided to scanner
 //! density: slicing alone, the full `symmetrize` (alone, and with the pictures it writes:
-//! `preview.png` and `sections.svg`), and the whole `dressform slice` process.
+//! `preview.png` and `sections.svg`), and the whole `dressform slice` process; then
+//! `reconstruct` (issue 15) of a posed MakeHuman body at 300k triangles: the fit alone, the
+//! library call, and the whole `dressform reconstruct` process with its seven outputs.
 //!
 //! `cargo bench --bench pipeline`; needs `../shared/makehuman` (or `$DRESSFORM_MAKEHUMAN`).
 
@@ -125,5 +127,59 @@ fn benches(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(pipeline, benches);
+/// Issue 15's benchmark size: a scan of 300k triangles.
+const RECONSTRUCT_TRIANGLES: usize = 300_000;
+
+fn reconstruct_benches(c: &mut Criterion) {
+    use dressform::body_model::BodyModel;
+    use dressform::fit::{self, FitOptions, ScanPoints};
+    use dressform::makehuman::{MakeHuman, Pose};
+    use dressform::reconstruct::{ReconstructOptions, reconstruct};
+    let Some(dir) = makehuman() else {
+        eprintln!("SKIPPED: MakeHuman assets not found (set DRESSFORM_MAKEHUMAN)");
+        return;
+    };
+    // A customer with the left arm 15 degrees further out and the right leg 5 out.
+    let mh = MakeHuman::load(&dir).expect("the MakeHuman assets load");
+    let body = mh.shaped(&[]).expect("the mean body");
+    let pose = Pose::rest()
+        .rotate("upperarm01.L", DVec3::Y * -15f64.to_radians())
+        .rotate("upperleg01.R", DVec3::Y * 5f64.to_radians());
+    let skin = mh.base.skin(&mh.pose(&body, &pose).expect("posed"));
+    let k = (RECONSTRUCT_TRIANGLES as f64 / skin.triangles.len() as f64).sqrt().ceil() as u32;
+    let dense = subdivide(&skin, k);
+    let n = dense.triangles.len();
+    let tmp = tempfile::tempdir().expect("temporary directory");
+    let ply = tmp.path().join("scan.ply");
+    std::fs::write(&ply, Format::Ply.encode(&dense)).expect("write the PLY");
+    let scan = scan::load(&ply, &FrameOptions::default()).expect("the scan loads");
+    let model = BodyModel::builtin();
+    let mut group = c.benchmark_group("reconstruct");
+    group.sample_size(10);
+    group.bench_function(format!("fit alone, {n} triangles"), |b| {
+        b.iter(|| {
+            let points = ScanPoints::of_mesh(&scan.body);
+            fit::fit(&model, &points, &FitOptions::default()).expect("fit")
+        })
+    });
+    group.bench_function(format!("reconstruct (library), {n} triangles"), |b| {
+        b.iter(|| {
+            reconstruct(&scan, &model, &ReconstructOptions::default(), |_| {}).expect("reconstruct")
+        })
+    });
+    let out = tmp.path().join("out");
+    group.bench_function(format!("dressform reconstruct process, {n} triangles"), |b| {
+        b.iter(|| {
+            let run = std::process::Command::new(env!("CARGO_BIN_EXE_dressform"))
+                .args(["reconstruct", ply.to_str().expect("utf-8 path"), "-o"])
+                .arg(&out)
+                .output()
+                .expect("dressform runs");
+            assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(pipeline, benches, reconstruct_benches);
 criterion_main!(pipeline);

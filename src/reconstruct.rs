@@ -77,9 +77,8 @@ pub fn reconstruct(
 ) -> Result<Reconstruction, ReconstructError> {
     progress(0);
     let body = &scan.body;
-    let normals = fit::params::vertex_normals(&body.positions, &body.triangles);
     let start = std::time::Instant::now();
-    let fitted = fit::fit(model, &body.positions, &normals, &options.fit)?;
+    let fitted = fit::fit(model, &fit::ScanPoints::of_mesh(body), &options.fit)?;
     let fit_seconds = start.elapsed().as_secs_f64();
     let residuals = verdict::residuals(model, &fitted, &body.positions);
     verdict::verdict(&residuals)?;

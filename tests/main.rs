@@ -25,6 +25,7 @@ mod mannequin_quality;
 mod measurements;
 mod outputs;
 mod pose_symmetry;
+mod pose_symmetry_cases;
 mod preview;
 mod run_end_to_end;
 mod segmentation;

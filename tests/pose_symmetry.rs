@@ -115,7 +115,9 @@ fn arm_and_leg_abduction_are_recovered_from_makehuman_scans() {
         let (points, normals) = scan_of(&mh.base.skin(&posed), &mut rng);
         let truth = mh.rig.bone_heads(&posed);
         let start = std::time::Instant::now();
-        let fitted = fit::fit(&model, &points, &normals, &FitOptions::default()).unwrap();
+        let fitted =
+            fit::fit(&model, &fit::ScanPoints::of_cloud(&points, normals), &FitOptions::default())
+                .unwrap();
         let seconds = start.elapsed().as_secs_f64();
         let joints = fitted.joints(&model);
         let mut line = format!(

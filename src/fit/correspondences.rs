@@ -1,9 +1,13 @@
 //! Closest-point pairs both ways between the posed model and the scan (eq. 4's data term):
 //! model vertices to their nearest scan points, and sampled scan points to their nearest model
-//! vertices, each pair rejected when the two normals disagree, each weighted robustly
-//! ([`super::robust`]). Nearest neighbours by `kiddo` k-d trees.
+//! vertices, each pair rejected when the two normals disagree or the scan point lies on a hole's
+//! boundary (Turk & Levoy 1994: a model vertex over a hole finds its nearest scan point on the
+//! rim, and would be dragged there), each weighted robustly ([`super::robust`]). Nearest
+//! neighbours by `kiddo` k-d trees.
 
+use super::params::vertex_normals;
 use super::robust;
+use crate::mesh::{Mesh, topology};
 use glam::{DMat3, DVec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -17,24 +21,55 @@ pub const MIN_NORMAL_COS: f64 = 0.5;
 /// common choice in registration).
 pub const POINT_TO_POINT: f64 = 0.1;
 
-/// The scan: points and unit normals, with a k-d tree over the points.
-pub struct ScanCloud<'a> {
+/// The scan as the fit sees it: points, unit outward normals, and which points lie on the
+/// boundary of a hole.
+pub struct ScanPoints<'a> {
     /// The points (mm, canonical frame).
     pub points: &'a [DVec3],
     /// Their unit outward normals.
-    pub normals: &'a [DVec3],
+    pub normals: Vec<DVec3>,
+    /// Per point, whether it lies on a hole's boundary (all `false` for a bare point cloud).
+    pub on_hole_boundary: Vec<bool>,
+}
+
+impl<'a> ScanPoints<'a> {
+    /// A scan mesh's vertices, with its vertex normals and its boundary loops.
+    pub fn of_mesh(mesh: &'a Mesh) -> Self {
+        let mut on_hole_boundary = vec![false; mesh.positions.len()];
+        for v in topology(mesh).boundary_loops.iter().flatten() {
+            on_hole_boundary[*v as usize] = true;
+        }
+        ScanPoints {
+            points: &mesh.positions,
+            normals: vertex_normals(&mesh.positions, &mesh.triangles),
+            on_hole_boundary,
+        }
+    }
+
+    /// A point cloud with unit `normals` (no holes known).
+    pub fn of_cloud(points: &'a [DVec3], normals: Vec<DVec3>) -> Self {
+        ScanPoints { points, on_hole_boundary: vec![false; points.len()], normals }
+    }
+}
+
+/// The scan indexed for pairing: a k-d tree over its points, and its samples.
+pub struct ScanCloud<'a> {
+    /// The scan.
+    pub scan: &'a ScanPoints<'a>,
     tree: ImmutableKdTree<f64, 3>,
-    /// The scan points used for scan-to-model pairs.
+    /// The scan points used for scan-to-model pairs (none on a hole's boundary).
     samples: Vec<usize>,
 }
 
 impl<'a> ScanCloud<'a> {
-    /// Indexes `points` and picks every `stride`-th one as a sample for scan-to-model pairs.
-    pub fn new(points: &'a [DVec3], normals: &'a [DVec3], stride: usize) -> Self {
-        let coords: Vec<[f64; 3]> = points.iter().map(|p| p.to_array()).collect();
+    /// Indexes `scan` and picks every `stride`-th point off the holes' boundaries as a sample
+    /// for scan-to-model pairs.
+    pub fn new(scan: &'a ScanPoints<'a>, stride: usize) -> Self {
+        let coords: Vec<[f64; 3]> = scan.points.iter().map(|p| p.to_array()).collect();
         let tree = ImmutableKdTree::new_from_slice(&coords);
-        let samples = (0..points.len()).step_by(stride.max(1)).collect();
-        ScanCloud { points, normals, tree, samples }
+        let samples =
+            (0..scan.points.len()).step_by(stride.max(1)).filter(|&s| !scan.on_hole_boundary[s]);
+        ScanCloud { scan, tree, samples: samples.collect() }
     }
 }
 
@@ -68,7 +103,8 @@ struct Pair {
 
 /// The pairs both ways between the posed model (`vertices` with `normals`) and the scan, robust
 /// weights at scale `sigma` (mm), gathered per vertex.
-pub fn gather(scan: &ScanCloud, vertices: &[DVec3], normals: &[DVec3], sigma: f64) -> Quadratics {
+pub fn gather(cloud: &ScanCloud, vertices: &[DVec3], normals: &[DVec3], sigma: f64) -> Quadratics {
+    let scan = cloud.scan;
     let weigh = |vertex: usize, target: DVec3, normal: DVec3| {
         let d = vertices[vertex] - target;
         let plane = normal.dot(d);
@@ -84,15 +120,15 @@ pub fn gather(scan: &ScanCloud, vertices: &[DVec3], normals: &[DVec3], sigma: f6
     let to_scan: Vec<Pair> = (0..vertices.len())
         .into_par_iter()
         .filter_map(|v| {
-            let hit = scan.tree.nearest_one::<SquaredEuclidean>(&vertices[v].to_array());
+            let hit = cloud.tree.nearest_one::<SquaredEuclidean>(&vertices[v].to_array());
             let s = hit.item as usize;
-            (normals[v].dot(scan.normals[s]) >= MIN_NORMAL_COS)
-                .then(|| weigh(v, scan.points[s], scan.normals[s]))
+            let agree = normals[v].dot(scan.normals[s]) >= MIN_NORMAL_COS;
+            (agree && !scan.on_hole_boundary[s]).then(|| weigh(v, scan.points[s], scan.normals[s]))
         })
         .collect();
     let coords: Vec<[f64; 3]> = vertices.iter().map(|p| p.to_array()).collect();
     let model_tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&coords);
-    let to_model: Vec<Pair> = scan
+    let to_model: Vec<Pair> = cloud
         .samples
         .par_iter()
         .filter_map(|&s| {

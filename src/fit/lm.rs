@@ -5,7 +5,6 @@
 
 use super::correspondences::Quadratics;
 use super::params::{Params, Posed, Prepared};
-use super::priors::{BETA_PRIOR_MM2, POSE_PRIOR_MM2_PER_RAD2};
 use glam::DVec3;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -20,14 +19,8 @@ const LAMBDA_DOWN: f64 = 3.0;
 const LAMBDA_MAX: f64 = 1e8;
 
 /// The energy of eq. 4 at `params`: the data cost of the posed vertices plus the priors.
-pub fn energy(data: &Quadratics, params: &Params, posed: &Posed) -> f64 {
-    data.cost(&posed.vertices) + prior(params)
-}
-
-fn prior(params: &Params) -> f64 {
-    BETA_PRIOR_MM2 * params.beta.iter().map(|b| b * b).sum::<f64>()
-        + POSE_PRIOR_MM2_PER_RAD2
-            * params.theta.iter().skip(1).map(|t| t.length_squared()).sum::<f64>()
+pub fn energy(prep: &Prepared, data: &Quadratics, params: &Params, posed: &Posed) -> f64 {
+    data.cost(&posed.vertices) + prep.priors.cost(params)
 }
 
 /// The result of one iteration.
@@ -53,28 +46,13 @@ pub fn iterate(
 ) -> Step {
     let n = prep.layout.size();
     let (mut h, mut g) = normal_equations(prep, data, posed);
-    // Priors: beta (residual sqrt(c) beta) and the bones' angles (residual sqrt(c) theta_k,
-    // d theta_k / d w_k = A_parent^T, so J^T J = c I and J^T r = c A_parent theta_k).
-    for k in 0..prep.layout.k {
-        let i = prep.layout.beta(k);
-        h[(i, i)] += BETA_PRIOR_MM2;
-        g[i] += BETA_PRIOR_MM2 * params.beta[k];
-    }
+    prep.priors.add_to(prep.layout, params, posed, &mut h, &mut g);
     let parents = &prep.model.skeleton.parents;
-    for (b, theta) in params.theta.iter().enumerate().skip(1) {
-        let above = parents[b].map_or(glam::DMat3::IDENTITY, |p| posed.g[p].matrix3);
-        let pull = above * *theta * POSE_PRIOR_MM2_PER_RAD2;
-        let at = prep.layout.bone(b);
-        for d in 0..3 {
-            h[(at + d, at + d)] += POSE_PRIOR_MM2_PER_RAD2;
-            g[at + d] += pull[d];
-        }
-    }
     let index: Vec<usize> = (0..n).filter(|&i| active[i]).collect();
     let m = index.len();
     let hr = DMatrix::from_fn(m, m, |r, c| h[(index[r], index[c])]);
     let gr = DVector::from_fn(m, |r, _| g[index[r]]);
-    let before = energy(data, params, posed);
+    let before = energy(prep, data, params, posed);
     let mut lambda = lambda;
     while lambda <= LAMBDA_MAX {
         let mut damped = hr.clone();
@@ -87,7 +65,7 @@ pub fn iterate(
             index.iter().zip(dx.iter()).for_each(|(&i, &d)| full[i] = d);
             let next = params.step(prep.layout, posed, parents, &full);
             let next_posed = prep.pose(&next);
-            let after = energy(data, &next, &next_posed);
+            let after = energy(prep, data, &next, &next_posed);
             if after < before {
                 return Step { params: next, before, after, lambda: lambda / LAMBDA_DOWN };
             }

@@ -4,23 +4,27 @@
 //!
 //! Robust ICP with a Levenberg-Marquardt step ([`lm`]): closest points both ways
 //! ([`correspondences`]), point-to-plane plus a little point-to-point, pairs rejected where the
-//! normals disagree, Geman-McClure weights ([`robust`]) annealed coarse to fine, a prior on
-//! beta and a weak one on the angles ([`priors`]). Coarse to fine in the unknowns as well
+//! normals disagree or the scan point lies on a hole's boundary, Geman-McClure weights
+//! ([`robust`]) annealed coarse to fine; eq. 4's regularisers ([`priors`]): a prior on beta,
+//! joint limits ([`joint_limits`]), a smoothness prior along the spine, a weak pull of the
+//! angles to rest and a stiffer one on the clavicles. Coarse to fine in the unknowns as well
 //! ([`STAGES`]): global placement and shape, then spine, shoulders, arms and hips, then every
 //! bone. Before the limbs are freed the arms try several abductions ([`arm_starts`]) against
 //! the local minimum of an arm matched to the torso.
 //!
 //! ```no_run
 //! use dressform::{body_model::BodyModel, fit};
-//! # let (points, normals): (Vec<glam::DVec3>, Vec<glam::DVec3>) = (vec![], vec![]);
+//! # let scan = dressform::mesh::Mesh::new(vec![], vec![]);
 //! let model = BodyModel::builtin();
-//! let fitted = fit::fit(&model, &points, &normals, &fit::FitOptions::default())?;
+//! let points = fit::ScanPoints::of_mesh(&scan);
+//! let fitted = fit::fit(&model, &points, &fit::FitOptions::default())?;
 //! println!("{} iterations, beta {:?}", fitted.iterations, fitted.beta);
 //! # Ok::<(), dressform::fit::FitError>(())
 //! ```
 
 pub mod arm_starts;
 pub mod correspondences;
+pub mod joint_limits;
 pub mod lm;
 pub mod params;
 pub mod priors;
@@ -28,6 +32,7 @@ pub mod robust;
 pub mod verdict;
 
 use correspondences::ScanCloud;
+pub use correspondences::ScanPoints;
 use glam::DVec3;
 use params::{Params, Prepared, vertex_normals};
 
@@ -151,19 +156,20 @@ pub enum FitError {
 /// model triangle's worth of surface).
 pub const MIN_POINTS: usize = 1000;
 
-/// Fits `model` to scan points (canonical frame: mm, Z up, facing -Y) with unit outward
-/// `normals`, starting from the mean model at rest placed on the scan's bounding box.
+/// Fits `model` to `scan` (canonical frame: mm, Z up, facing -Y), starting from the mean model
+/// at rest placed on the scan's bounding box.
 pub fn fit(
     model: &crate::body_model::BodyModel,
-    points: &[DVec3],
-    normals: &[DVec3],
+    scan: &ScanPoints,
     options: &FitOptions,
 ) -> Result<Fit, FitError> {
-    if points.len() != normals.len() {
+    let (points, normals) = (scan.points, &scan.normals);
+    if points.len() != normals.len() || points.len() != scan.on_hole_boundary.len() {
         return Err(FitError::Input(format!(
-            "{} points but {} normals",
+            "{} points, {} normals and {} hole-boundary flags",
             points.len(),
-            normals.len()
+            normals.len(),
+            scan.on_hole_boundary.len()
         )));
     }
     if points.len() < MIN_POINTS {
@@ -174,7 +180,7 @@ pub fn fit(
     }
     let prep = Prepared::new(model);
     let stride = (1.0 / options.sample_fraction.clamp(1e-3, 1.0)).round() as usize;
-    let scan = ScanCloud::new(points, normals, stride);
+    let cloud = ScanCloud::new(scan, stride);
     let centre = |p: &[DVec3]| {
         let b = crate::mesh::Aabb::around(p.iter().copied()).expect("not empty");
         (b.min + b.max) / 2.0
@@ -185,13 +191,13 @@ pub fn fit(
     for (s, stage) in options.stages.iter().enumerate() {
         let active = active(&prep, stage.bones);
         if stage.bones != Bones::Global && s > 0 && options.stages[s - 1].bones == Bones::Global {
-            params = arm_starts::best(&prep, &scan, params, stage.sigma_mm);
+            params = arm_starts::best(&prep, &cloud, params, stage.sigma_mm);
         }
         let mut lambda = lm::LAMBDA_START;
         for _ in 0..stage.iterations {
             let posed = prep.pose(&params);
             let normals = vertex_normals(&posed.vertices, &model.triangles);
-            let data = correspondences::gather(&scan, &posed.vertices, &normals, stage.sigma_mm);
+            let data = correspondences::gather(&cloud, &posed.vertices, &normals, stage.sigma_mm);
             let step = lm::iterate(&prep, &data, &params, &posed, &active, lambda);
             iterations += 1;
             params = step.params;

@@ -1,9 +1,21 @@
-//! The priors of the fit energy (eq. 4's regularisers): a Gaussian prior on the shape
-//! coefficients (beta is in standard deviations of the population, so `|beta|^2` is its
-//! negative log-likelihood up to a constant), and a weak pull of every bone's angle towards the
-//! rest pose so that bones the scan cannot see (hands, feet in a hole) stay put.
+//! The regularisers of eq. 4, beside the data term: a Gaussian prior on the shape coefficients
+//! (beta is in standard deviations of the population, so `|beta|^2` is its negative
+//! log-likelihood up to a constant), a weak pull of every bone's angle towards the rest pose
+//! (bones the scan cannot see, hands and feet in a hole, stay put), a stiffer one on the
+//! clavicles (the scapulohumeral rhythm), soft joint limits ([`super::joint_limits`]) and a
+//! smoothness prior along the spine (neighbouring spine bones turn alike).
 //!
-//! Both are in the units of the data term: the mean squared distance per pair (mm^2).
+//! All are in the units of the data term: the mean squared distance per pair (mm^2). Each
+//! pose term is a weighted squared residual `r^T W r` with `r` linear in bone angles,
+//! `r = sum_i s_i theta_{b_i} - r0`; bone `b`'s angle moves with its world-frame increment `w`
+//! as `d theta_b / d w = A_parent(b)^T` (the parent's rotation), which gives the normal
+//! equations' blocks `s_i s_j A_i W A_j^T` and gradient `s_i A_i W r`.
+
+use super::joint_limits::JointLimits;
+use super::params::{Layout, Params, Posed};
+use crate::body_model::Skeleton;
+use glam::{DMat3, DVec3};
+use nalgebra::{DMatrix, DVector};
 
 /// The cost of one standard deviation of shape, in mm^2 of mean squared distance: a shape
 /// coefficient must buy at least about a millimetre of fit to be used (chosen by the recovered
@@ -14,3 +26,120 @@ pub const BETA_PRIOR_MM2: f64 = 1.0;
 /// tie-breaker for bones with no data, not a pull on limbs the scan shows (10 degrees cost
 /// 0.3 mm^2).
 pub const POSE_PRIOR_MM2_PER_RAD2: f64 = 10.0;
+
+/// The clavicles' pull towards rest, many times the other bones': in the scapulohumeral rhythm
+/// (Inman, Saunders & Abbott 1944; Ludewig et al. 2009) the clavicle rises about one degree
+/// for every ten of arm elevation below the shoulder line, so an arm further out is the arm's
+/// own angle, not the clavicle's. The model's clavicle also carries the deltoid, so without
+/// this the fit lifts it to follow a raised arm's shoulder (5 degrees cost 0.8 mm^2, about
+/// what matching the deltoid gains).
+pub const CLAVICLE_PRIOR_MM2_PER_RAD2: f64 = 100.0;
+
+/// The cost of a radian beyond a joint limit: a wall (a degree outside costs 3 mm^2, more than
+/// a whole limb's data gains), still smooth enough for Gauss-Newton.
+pub const LIMIT_MM2_PER_RAD2: f64 = 10_000.0;
+
+/// The cost of a radian of difference between neighbouring spine bones' angles: the spine bends
+/// as a smooth curve (its discs share a bend; White & Panjabi 1990), so a sideways bend or twist
+/// spreads over the chain rather than kinking at one bone to follow a hole or an arm (a
+/// 5-degree kink costs 0.8 mm^2).
+pub const SPINE_SMOOTHNESS_MM2_PER_RAD2: f64 = 100.0;
+
+/// The spine's chain, pelvis up: neighbours are smoothed against each other.
+const SPINE: [&str; 4] = ["spine04", "spine03", "spine02", "spine01"];
+
+/// The pose regularisers of one skeleton.
+pub struct Priors {
+    /// Per bone, the stiffness of its pull towards rest (mm^2 per rad^2; the root's is zero).
+    stiffness: Vec<f64>,
+    limits: JointLimits,
+    /// Neighbouring spine bones `(lower, upper)`.
+    spine: Vec<(usize, usize)>,
+    parents: Vec<Option<usize>>,
+}
+
+/// One pose term: bones with their signs, the residual and its per-axis weight.
+struct Term {
+    bones: Vec<(usize, f64)>,
+    r: DVec3,
+    w: DVec3,
+}
+
+impl Priors {
+    /// The priors of `skeleton`.
+    pub fn new(skeleton: &Skeleton) -> Self {
+        let find = |name: &str| skeleton.names.iter().position(|n| n == name);
+        let stiffness = (0..skeleton.names.len())
+            .map(|b| match b {
+                0 => 0.0,
+                _ if skeleton.names[b].starts_with("clavicle") => CLAVICLE_PRIOR_MM2_PER_RAD2,
+                _ => POSE_PRIOR_MM2_PER_RAD2,
+            })
+            .collect();
+        let chain: Vec<usize> = SPINE.iter().filter_map(|n| find(n)).collect();
+        Priors {
+            stiffness,
+            limits: JointLimits::new(skeleton),
+            spine: chain.windows(2).map(|w| (w[0], w[1])).collect(),
+            parents: skeleton.parents.clone(),
+        }
+    }
+
+    /// Every pose term at `theta`.
+    fn terms<'a>(&'a self, theta: &'a [DVec3]) -> impl Iterator<Item = Term> + 'a {
+        let pulls = (1..theta.len()).map(move |b| Term {
+            bones: vec![(b, 1.0)],
+            r: theta[b],
+            w: DVec3::splat(self.stiffness[b]),
+        });
+        let limits = (1..theta.len()).filter_map(move |b| {
+            let r = self.limits.excess(b, theta[b]);
+            let on = |e: f64| if e != 0.0 { LIMIT_MM2_PER_RAD2 } else { 0.0 };
+            (r != DVec3::ZERO).then(|| Term { bones: vec![(b, 1.0)], r, w: r.map(on) })
+        });
+        let spine = self.spine.iter().map(move |&(a, b)| Term {
+            bones: vec![(a, 1.0), (b, -1.0)],
+            r: theta[a] - theta[b],
+            w: DVec3::splat(SPINE_SMOOTHNESS_MM2_PER_RAD2),
+        });
+        pulls.chain(limits).chain(spine)
+    }
+
+    /// The regularisers' cost at `params`.
+    pub fn cost(&self, params: &Params) -> f64 {
+        let pose: f64 = self.terms(&params.theta).map(|t| t.r.dot(t.w * t.r)).sum();
+        pose + BETA_PRIOR_MM2 * params.beta.iter().map(|b| b * b).sum::<f64>()
+    }
+
+    /// Adds the regularisers' Gauss-Newton blocks and gradient (halved, like the data term's)
+    /// at `params`, posed as `posed`, to `h` and `g`.
+    pub fn add_to(
+        &self,
+        layout: Layout,
+        params: &Params,
+        posed: &Posed,
+        h: &mut DMatrix<f64>,
+        g: &mut DVector<f64>,
+    ) {
+        for k in 0..layout.k {
+            let i = layout.beta(k);
+            h[(i, i)] += BETA_PRIOR_MM2;
+            g[i] += BETA_PRIOR_MM2 * params.beta[k];
+        }
+        let above = |b: usize| self.parents[b].map_or(DMat3::IDENTITY, |p| posed.g[p].matrix3);
+        for term in self.terms(&params.theta) {
+            let w = DMat3::from_diagonal(term.w);
+            for &(bi, si) in &term.bones {
+                let ai = above(bi);
+                let grad = si * (ai * (w * term.r));
+                for &(bj, sj) in &term.bones {
+                    let block = si * sj * (ai * w * above(bj).transpose());
+                    for (r, c) in (0..3).flat_map(|r| (0..3).map(move |c| (r, c))) {
+                        h[(layout.bone(bi) + r, layout.bone(bj) + c)] += block.col(c)[r];
+                    }
+                }
+                (0..3).for_each(|d| g[layout.bone(bi) + d] += grad[d]);
+            }
+        }
+    }
+}
