@@ -79,8 +79,7 @@ struct Report {
     /// Mannequin crotch height minus the body's (mm).
     crotch_change: f64,
     /// The largest crease (degrees) where the legs join the torso, across the thighs and hips,
-    /// and around it (see [`crotch_creases`]). Printed, not yet held: on most of the 24 bodies
-    /// the join is sharper than the layers around it (issue 12, the line across the thighs).
+    /// and around it (see [`crotch_creases`]).
     seam_crease: (f64, f64),
     mirror_gap: f64,
     /// The largest change of a torso layer's tape girth below the shoulder points, measured
@@ -117,6 +116,12 @@ const SHOULDER_LINE_MM: f64 = 5.0;
 const LEG_STANCE_DEG: f64 = 0.5;
 /// The largest near-horizontal face allowed in that band (mm²: 1 cm², from the issue).
 const LEDGE_FACE_MM2: f64 = 100.0;
+
+/// The sharpest crease allowed where the legs join the torso, away from the plane (degrees):
+/// the layers around the join crease up to 45 degrees on the bodies tested (random-4) and the
+/// join stays below 53 (it folded up to 165 degrees when it was matched by arc length: a line
+/// across the thighs in every shaded picture).
+const SEAM_CREASE_DEG: f64 = 60.0;
 
 /// How far the crease check stays from the symmetry plane (mm): at the crotch itself the
 /// inner thighs meet in a saddle that is sharp on every body.
@@ -356,6 +361,7 @@ fn check_all(cases: Vec<Case>) {
             r.crotch_ledge.0 <= r.body_crotch_ledge + LEDGE_FACE_MM2,
             "{name}: flatter at the crotch than the body: {r:?}"
         );
+        assert!(r.seam_crease.0 <= SEAM_CREASE_DEG, "{name}: the crotch join creases: {r:?}");
         assert!(r.crotch_change.abs() <= 2.0, "{name}: crotch height {:+.2} mm", r.crotch_change);
         assert!(
             r.mirror_gap < 0.1,

@@ -6,12 +6,14 @@
 //! are cut at the armholes ([`crate::regions::Armhole`]), so the arms are not part of the
 //! torso: the cut edges of the layers stack into flat arm plates, and above the shoulder points
 //! the layers follow the shoulders with their slope, eased where the body's shoulder top is
-//! nearly level ([`shoulders`]). All layers share one symmetry plane, x = `axis`: the median of
+//! nearly level ([`shoulders`]). The legs' top layers are eased into the hips above them
+//! ([`thighs`]), so the crotch join has no step. All layers share one symmetry plane, x = `axis`: the median of
 //! the torso sections' bounding-box centres.
 
 mod layers;
 mod rebuild;
 mod shoulders;
+mod thighs;
 
 use crate::mesh::Mesh;
 use crate::regions::{Armhole, BodyRegions, Landmarks, Region, RegionError};
@@ -157,7 +159,7 @@ pub fn build(
         });
     }
     crate::symmetry::check_rays(options.rays)?;
-    let layers::SymmetricLayers { axis, mut torso, left_leg, right_leg } =
+    let layers::SymmetricLayers { axis, mut torso, mut left_leg, mut right_leg } =
         layers::symmetric_layers(body, regions, keep, options)?;
     let lm = &regions.landmarks;
     shoulders::ease(
@@ -165,6 +167,7 @@ pub fn build(
         axis,
         lm.left_armhole.shoulder_point.z.min(lm.right_armhole.shoulder_point.z),
     );
+    thighs::ease(&torso[0], &mut left_leg, &mut right_leg);
     let mesh = rebuild::rebuild(&torso, &left_leg, &right_leg, axis, regions.landmarks.crotch);
     Ok(Mannequin {
         axis,

@@ -10,11 +10,13 @@
 //! - **The crotch** ([`crotch`]): the lowest torso ring sits just above the crotch. A seam
 //!   runs on the symmetry plane at the crotch height from that ring's front midline vertex to
 //!   its back one. Each leg's top ring is stitched to its half of the lowest torso ring closed
-//!   by the seam: the two curves are matched piece by piece between anchors (the front and back
-//!   ends of the seam and the leg ring's vertices nearest to them), by arc length within each
-//!   piece, so the outside of the thigh meets the side of the hip and the inside of the thigh
-//!   meets the seam. Both legs share the seam's edges: one surface, closed and manifold, with
-//!   its lowest point on the symmetry plane at the crotch height.
+//!   by the seam: each vertex of that half ring takes the parameter of its closest point on
+//!   the leg ring (never running backwards), so each part of the thigh meets the part of the
+//!   hip or the seam right above it and the band stands upright where the two rings agree.
+//!   (Matching the two curves by arc length made the band drift up to 26 mm sideways over its
+//!   2 mm of height and fold up to 165 degrees.) Both legs share the seam's edges: one
+//!   surface, closed and manifold, with its lowest point on the symmetry plane at the crotch
+//!   height.
 //! - **Caps** (a fan around the ring's centre, flat) close the neck and the two ankles.
 
 use super::Layer;
@@ -119,22 +121,59 @@ fn arc_lengths(points: &[DVec2]) -> Vec<f64> {
     s
 }
 
-/// Parameters for a closed ring of `points` matched piecewise to another: vertex 0 and
-/// vertex `anchor` (`0..=len`; `len` is vertex 0 come round again) are the two anchors, the
-/// first piece (0 to `anchor`) takes `[0, 1/2)` and the second `[1/2, 1)`, each by arc length.
-fn anchored_params(points: &[DVec2], anchor: usize) -> Vec<f64> {
-    let (n, s) = (points.len(), arc_lengths(points));
-    let piece = |from: usize, to: usize, k: usize| {
-        let length = s[to] - s[from];
-        if length > 0.0 { (s[k] - s[from]) / length } else { 0.0 }
-    };
-    (0..n)
-        .map(|k| match k {
-            0 => 0.0,
-            k if k < anchor => 0.5 * piece(0, anchor, k),
-            k => 0.5 + 0.5 * piece(anchor, n, k),
-        })
-        .collect()
+/// Arc-length parameters (`[0, 1)`, from vertex 0) of the vertices of the closed ring
+/// `points`.
+fn arc_params(points: &[DVec2]) -> Vec<f64> {
+    let s = arc_lengths(points);
+    let total = s[points.len()].max(f64::MIN_POSITIVE);
+    s[..points.len()].iter().map(|l| l / total).collect()
+}
+
+/// The point of the closed ring `curve` closest to `p`: (the index of the edge it lies on,
+/// its fraction along that edge, the point).
+pub(super) fn closest_on_ring(curve: &[DVec2], p: DVec2) -> (usize, f64, DVec2) {
+    let n = curve.len();
+    let mut best = (0, 0.0, curve[0]);
+    for k in 0..n {
+        let (a, b) = (curve[k], curve[(k + 1) % n]);
+        let ab = b - a;
+        let t = ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+        let q = a + ab * t;
+        if q.distance_squared(p) < best.2.distance_squared(p) {
+            best = (k, t, q);
+        }
+    }
+    best
+}
+
+/// The arc-length parameter (`[0, 1)`, from vertex 0) of the point of the closed ring `curve`
+/// (cumulative arc lengths `s`) closest to `p`.
+fn closest_param(curve: &[DVec2], s: &[f64], p: DVec2) -> f64 {
+    let (k, t, _) = closest_on_ring(curve, p);
+    (s[k] + t * (s[k + 1] - s[k])) / s[curve.len()].max(f64::MIN_POSITIVE)
+}
+
+/// Parameters of the closed ring `points` (starting where `curve` starts) read off the
+/// closed ring `curve` below it: each vertex takes the arc-length parameter of its closest
+/// point on `curve`, kept from running backwards (a vertex whose closest point lies behind
+/// its predecessor's takes the predecessor's parameter: a fan). So each part of the one ring
+/// meets the part of the other right beside it, and the band between them stands upright
+/// where the rings agree instead of drifting sideways along them.
+fn projected_params(points: &[DVec2], curve: &[DVec2]) -> Vec<f64> {
+    let s = arc_lengths(curve);
+    let mut params = Vec::with_capacity(points.len());
+    let mut previous = 0.0;
+    for (k, &p) in points.iter().enumerate() {
+        let raw = closest_param(curve, &s, p);
+        // The parameter wraps at the start: take the reading nearest to the predecessor's.
+        let unwrapped = [raw - 1.0, raw, raw + 1.0]
+            .into_iter()
+            .min_by(|a, b| (a - previous).abs().total_cmp(&(b - previous).abs()))
+            .expect("three readings");
+        previous = if k == 0 { 0.0 } else { unwrapped.clamp(previous, 1.0) };
+        params.push(previous);
+    }
+    params
 }
 
 /// Index of the point of `points` nearest to `p`.
@@ -146,25 +185,18 @@ fn nearest(points: &[DVec2], p: DVec2) -> usize {
 
 /// Stitches a leg's top ring (`leg`, vertex indices, counter-clockwise from above) to
 /// `boundary`: its half of the lowest torso ring closed by the seam, starting at the seam's
-/// front end, with the seam's back end at index `back` (see the module documentation).
-fn join_leg(mesh: &mut Mesh, leg: &[u32], boundary: Vec<u32>, back: usize) {
+/// front end (see the module documentation).
+fn join_leg(mesh: &mut Mesh, leg: &[u32], boundary: Vec<u32>) {
     let flat = |vs: &[u32]| -> Vec<DVec2> {
         vs.iter().map(|&v| mesh.positions[v as usize].truncate()).collect()
     };
     let (leg_points, boundary_points) = (flat(leg), flat(&boundary));
     let n = leg.len();
     let front_anchor = nearest(&leg_points, boundary_points[0]);
-    let back_anchor = nearest(&leg_points, boundary_points[back]);
     let rotated: Vec<u32> = (0..n).map(|k| leg[(front_anchor + k) % n]).collect();
-    let mut anchor = (back_anchor + n - front_anchor) % n;
-    if anchor == 0 {
-        // Both ends of the seam face one leg vertex: the whole leg ring faces the longer piece
-        // of the boundary (the half ring, not the seam).
-        let s = arc_lengths(&boundary_points);
-        anchor = if s[back] > s[boundary.len()] - s[back] { n } else { 0 };
-    }
-    let leg_params = anchored_params(&flat(&rotated), anchor);
-    let boundary_params = anchored_params(&boundary_points, back);
+    let rotated_points = flat(&rotated);
+    let leg_params = arc_params(&rotated_points);
+    let boundary_params = projected_params(&boundary_points, &rotated_points);
     stitch(
         mesh,
         &Ring { vertices: rotated, params: leg_params },
@@ -206,8 +238,8 @@ fn crotch(
     let mut right: Vec<u32> = vec![ring0[0]];
     right.extend(&seam);
     right.extend(&ring0[back..]);
-    join_leg(mesh, left_top, left, back);
-    join_leg(mesh, right_top, right, seam.len() + 1);
+    join_leg(mesh, left_top, left);
+    join_leg(mesh, right_top, right);
 }
 
 /// The mannequin mesh from its layers (each list bottom to top), its symmetry plane and the
