@@ -39,22 +39,35 @@ const GIRTH_MEAN_TOLERANCE_MM: f64 = 3.0;
 /// Misses this table still shows (issue 15 is not done), each with what is wrong: the test
 /// prints them loudly and fails on any other; a listed miss that now holds is printed too, so
 /// the list can shrink. `(case, quantity)` as in the misses' text.
-const KNOWN_MISSES: [(usize, &str, &str); 15] = [
+/// Why the chest misses on most cases since the chest is taken at the bust point (ISO 8559-1,
+/// issue 13) instead of just under the armpit: at the bust, the scan re-posed to the symmetric
+/// pose differs from the un-posed body by 6-19 mm (under the armpit it held within 5). The
+/// re-posing moves the bust: the model's skin weights there (pectoral, clavicle) or its
+/// symmetric arm angle; not yet found.
+const BUST_AFTER_REPOSING: &str =
+    "chest at the bust point: the re-posed bust differs from the un-posed body's by 6-19 mm";
+
+const KNOWN_MISSES: [(usize, &str, &str); 20] = [
+    (0, "girths", BUST_AFTER_REPOSING),
+    (1, "girths", BUST_AFTER_REPOSING),
+    (2, "girths", BUST_AFTER_REPOSING),
     (3, "spine bend", "asym/asymm-trunk-1-l bends the trunk itself: the fit reads it as pose"),
-    (3, "girths", "chest 5.4 mm: the asymmetric trunk's chest, as above"),
+    (4, "girths", BUST_AFTER_REPOSING),
     (4, "spine bend", "2.0 degrees read into a straight spine"),
+    (5, "girths", BUST_AFTER_REPOSING),
+    (7, "girths", BUST_AFTER_REPOSING),
     (8, "girths", "chest 5.3 mm after a 7.6-degree spine bend"),
-    (11, "girths", "chest 10.5 mm with only the head turned: not yet understood"),
-    (12, "girths", "chest 12.4 mm with only the head turned: not yet understood"),
+    (9, "girths", BUST_AFTER_REPOSING),
+    (10, "girths", BUST_AFTER_REPOSING),
     (13, "reconstruct", "an arm 35-60 degrees beyond the A-pose does not converge"),
     (14, "reconstruct", "an arm 35-60 degrees beyond the A-pose does not converge"),
     (15, "reconstruct", "an arm 35-60 degrees beyond the A-pose does not converge"),
     (16, "arm.L", "an arm 49 degrees out: 3.6 short, the clavicle takes it"),
     (16, "clav.L", "the clavicle takes part of an arm 49 degrees out"),
-    (16, "girths", "chest 8.0 mm with an arm 49 degrees out"),
     (17, "reconstruct", "an arm 35-60 degrees beyond the A-pose does not converge"),
     (18, "reconstruct", "an arm 35-60 degrees beyond the A-pose does not converge"),
     (19, "clav.R", "a depressed clavicle (-7.3) read as -3.7 (its stiff prior)"),
+    (19, "girths", BUST_AFTER_REPOSING),
 ];
 
 /// Body shapes, including targets the model was not built from (`bodyshapes/`, `asym/`).
