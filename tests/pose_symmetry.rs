@@ -173,20 +173,9 @@ fn scan_mesh(skin: &Mesh, rng: &mut ChaCha8Rng) -> Mesh {
     for p in &mut positions {
         *p += DVec3::new(noise.sample(rng), noise.sample(rng), noise.sample(rng));
     }
-    let b = dressform::mesh::Aabb::around(positions.iter().copied()).unwrap();
     let holes: Vec<DVec3> =
         (0..HOLES).map(|_| skin.positions[rng.random_range(0..skin.positions.len())]).collect();
-    let mut mesh = Mesh::new(positions, triangles);
-    let keep: Vec<bool> = (0..mesh.triangles.len())
-        .map(|t| {
-            let c = mesh.corners(t).iter().sum::<DVec3>() / 3.0;
-            let cut = c.z < b.min.z + CUT_MM || c.z > b.max.z - CUT_MM;
-            !cut && holes.iter().all(|h| h.distance(c) >= HOLE_RADIUS_MM)
-        })
-        .collect();
-    mesh.retain_triangles(|t| keep[t]);
-    mesh.drop_unused_vertices();
-    mesh
+    common::with_holes_and_cuts(Mesh::new(positions, triangles), &holes, HOLE_RADIUS_MM, CUT_MM)
 }
 
 /// Writes `mesh` (canonical mm, Z up) as an OBJ in metres with Y up when `metres_y_up`.

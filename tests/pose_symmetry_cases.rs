@@ -231,23 +231,13 @@ fn scanned(mesh: &Mesh, holes: &[DVec3], rng: &mut ChaCha8Rng) -> Mesh {
     for p in &mut mesh.positions {
         *p += DVec3::new(noise.sample(rng), noise.sample(rng), noise.sample(rng));
     }
-    let b = mesh.bounds().unwrap();
     let centres: Vec<DVec3> = holes
         .iter()
         .map(|h| {
             *mesh.positions.iter().min_by(|a, c| a.distance(*h).total_cmp(&c.distance(*h))).unwrap()
         })
         .collect();
-    let keep: Vec<bool> = (0..mesh.triangles.len())
-        .map(|t| {
-            let c = mesh.corners(t).iter().sum::<DVec3>() / 3.0;
-            let cut = c.z < b.min.z + CUT_MM || c.z > b.max.z - CUT_MM;
-            !cut && centres.iter().all(|h| h.distance(c) >= HOLE_RADIUS_MM)
-        })
-        .collect();
-    mesh.retain_triangles(|t| keep[t]);
-    mesh.drop_unused_vertices();
-    mesh
+    common::with_holes_and_cuts(mesh, &centres, HOLE_RADIUS_MM, CUT_MM)
 }
 
 /// Whether an error is over its limit, or not a number (a section that was not found).

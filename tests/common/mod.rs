@@ -222,3 +222,19 @@ pub fn uniform(seed: u64, k: u64, lo: f64, hi: f64) -> f64 {
     z ^= z >> 31;
     lo + (hi - lo) * (z >> 11) as f64 / (1u64 << 53) as f64
 }
+
+/// `mesh` as a scanner leaves it: the triangles within `cut_mm` of its lowest and highest
+/// point (the soles, the crown) removed, and those within `radius_mm` of each of `holes`.
+pub fn with_holes_and_cuts(mut mesh: Mesh, holes: &[DVec3], radius_mm: f64, cut_mm: f64) -> Mesh {
+    let b = mesh.bounds().expect("a scan has vertices");
+    let keep: Vec<bool> = (0..mesh.triangles.len())
+        .map(|t| {
+            let c = mesh.corners(t).iter().sum::<DVec3>() / 3.0;
+            let cut = c.z < b.min.z + cut_mm || c.z > b.max.z - cut_mm;
+            !cut && holes.iter().all(|h| h.distance(c) >= radius_mm)
+        })
+        .collect();
+    mesh.retain_triangles(|t| keep[t]);
+    mesh.drop_unused_vertices();
+    mesh
+}
