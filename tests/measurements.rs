@@ -1,22 +1,33 @@
 //! The measurement set against what the sim generator knows: stature, inside leg and the
 //! girths (torso, neck, legs, and the arms across their axes) measured on its implicit surface
-//! at the levels the rules chose, the shoulder width it was built with and the arm length
-//! between its joints; and `measure` on several scans at once,
+//! at the levels the rules chose, the neck base, across shoulder, across back and across
+//! front on its implicit surface in the planes and between the landmarks the rules chose,
+//! the shoulder width it was built with and the arm length between its joints; and `measure` on several scans at once,
 //! as CSV and JSON with the units in the keys.
 
 use crate::common;
 
 use common::{dressform, mesh_of};
-use dressform::measure::{ArmMeasures, BodyDimensions, arms, dimensions, levels};
+use dressform::measure::{
+    ArmMeasures, BodyDimensions, NeckAndShoulders, across_back_and_front, arms, dimensions, levels,
+    neck_and_shoulders, tape_arc,
+};
 use dressform::output::write_atomically;
+use dressform::regions::Landmarks;
 use dressform::regions::{BodyRegions, TRACKING_STEP_MM};
 use dressform::scan::format::Format;
+use dressform::slice::Contour;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use sim::capture::{BodyParams, SyntheticBody, generate};
 
 /// Girths against the generator's (mm): ISO 20685-1 allows 4 mm for small girths; the mesh
 /// (a 4 mm grid) reads a tape girth within about 1 mm.
 const GIRTH_MM: f64 = 2.0;
+/// Neck-base girth (mm): taken where the neck flares into the shoulders, the surface's
+/// sharpest bend, which the mesh's 4 mm grid rounds most: the mesh read 0.5-3.7 mm over the
+/// implicit surface on the six bodies of the test.
+const NECK_BASE_MM: f64 = 5.0;
 /// Stature and inside leg (mm): the mesh's top and crotch lie within a grid cell's fraction.
 const HEIGHT_MM: f64 = 2.0;
 /// Shoulder width (mm): the generator's acromion is a design point inside a smooth blend;
@@ -29,6 +40,38 @@ const ARM_LENGTH_MM: f64 = 45.0;
 /// the hand's blend (10 mm) thickens the forearm's end, so the narrowest level is just above.
 const WRIST_JOINT_MM: f64 = 30.0;
 
+/// The neck's and shoulders' measurements on the generator's implicit surface, in the planes
+/// and between the landmarks the rules chose on the mesh: (neck base, across shoulder, across
+/// back, across front).
+fn upper_torso_truth(body: &SyntheticBody, u: &NeckAndShoulders, m: &Landmarks) -> [f64; 4] {
+    let neck = &u.neck_base;
+    let neck_base =
+        body.girth_across(neck.origin.to_array(), neck.normal.to_array()).expect("inside the neck");
+    // The arc over the shoulders, in the plane's own coordinates.
+    let over = &u.across_shoulder;
+    let (e1, e2) = (
+        over.normal.any_orthonormal_vector(),
+        over.normal.cross(over.normal.any_orthonormal_vector()),
+    );
+    let flat = |p: DVec3| DVec2::new((p - over.origin).dot(e1), (p - over.origin).dot(e2));
+    let points = body
+        .section_across(over.origin.to_array(), over.normal.to_array())
+        .expect("inside the shoulders");
+    let loop_ =
+        Contour { points: points.into_iter().map(|p| flat(DVec3::from_array(p))).collect() };
+    let (lsp, rsp) = (m.left_armhole.shoulder_point, m.right_armhole.shoulder_point);
+    let across_shoulder = tape_arc(&loop_, flat(lsp), flat(rsp), flat(u.back_neck_point));
+    // Across back and front: the horizontal section, clipped by the mesh's arm plates.
+    let z = u.across_level;
+    let centre = body.torso_centre_at(z);
+    let points =
+        body.section_across([centre[0], centre[1], z], [0.0, 0.0, 1.0]).expect("inside the torso");
+    let section = Contour { points: points.into_iter().map(|p| DVec2::new(p[0], p[1])).collect() };
+    let torso = m.right_armhole.clip(&m.left_armhole.clip(&section, z), z);
+    let (back, front) = across_back_and_front(&torso, z, [&m.left_armhole, &m.right_armhole]);
+    [neck_base, across_shoulder, back, front]
+}
+
 /// (name, measured, known) for one body.
 fn compare(
     body: &SyntheticBody,
@@ -36,6 +79,7 @@ fn compare(
     arm: &[Option<ArmMeasures>; 2],
     crotch: f64,
     neck: f64,
+    upper: (&NeckAndShoulders, &Landmarks),
 ) -> Vec<(String, f64, f64)> {
     let t = &body.truth;
     let torso = |z: f64| body.girth_around(body.torso_centre_at(z), z).expect("inside the torso");
@@ -59,6 +103,12 @@ fn compare(
         ("neck".into(), d.neck_girth_mm, torso(neck)),
         ("shoulder width".into(), d.shoulder_width_mm, t.shoulder_width_mm),
     ];
+    let [neck_base, across_shoulder, across_back, across_front] =
+        upper_torso_truth(body, upper.0, upper.1);
+    rows.push(("neck base".into(), d.neck_base_girth_mm, neck_base));
+    rows.push(("across shoulder".into(), d.across_shoulder_mm, across_shoulder));
+    rows.push(("across back".into(), d.across_back_mm, across_back));
+    rows.push(("across front".into(), d.across_front_mm, across_front));
     for (left, name) in [(true, "left"), (false, "right")] {
         let pick = |b: &dressform::measure::Bilateral| if left { b.left } else { b.right };
         rows.push((format!("{name} thigh"), pick(&d.thigh_girth_mm), leg(left, thigh_z)));
@@ -110,7 +160,9 @@ fn the_measurement_set_matches_what_the_generator_knows() {
                 // Neck to waist: longer than the straight rise, shorter than half the stature.
                 assert!(w > m.neck - lv.waist && w < 0.5 * m.height, "seed {seed}: {w}");
             }
-            compare(&body, &d, &arms(&mesh, &regions), m.crotch, m.neck)
+            let upper =
+                neck_and_shoulders(&mesh, &regions).expect("the neck and shoulders are found");
+            compare(&body, &d, &arms(&mesh, &regions), m.crotch, m.neck, (&upper, m))
                 .into_iter()
                 .map(|(n, a, b)| (seed, n, a, b))
                 .collect::<Vec<_>>()
@@ -132,6 +184,7 @@ fn the_measurement_set_matches_what_the_generator_knows() {
             "stature" | "inside leg" => HEIGHT_MM,
             "shoulder width" => SHOULDER_MM,
             "arm length" => ARM_LENGTH_MM,
+            "neck base" => NECK_BASE_MM,
             _ => GIRTH_MM,
         };
         assert!(

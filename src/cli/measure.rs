@@ -139,7 +139,14 @@ fn csv_row(m: &MeasureOut) -> Result<Vec<(String, String)>, Failure> {
 fn print_text(m: &MeasureOut, at: &[f64]) {
     let d = &m.dimensions;
     outln!("{}", m.file);
-    let g = |name: &str, v: f64| outln!("  {name:<22} {v:7.1} mm");
+    let g = |name: &str, v: f64| {
+        if v.is_nan() {
+            // A fold or landmark the body does not show (see the README's rules).
+            outln!("  {name:<22} not measured")
+        } else {
+            outln!("  {name:<22} {v:7.1} mm")
+        }
+    };
     let b = |name: &str, v: &dressform::measure::Bilateral, unit: &str| {
         if v.difference.is_nan() {
             // An arm raised too high to be followed down its loops.
@@ -155,8 +162,12 @@ fn print_text(m: &MeasureOut, at: &[f64]) {
     };
     g("stature", d.stature_mm);
     g("neck girth", d.neck_girth_mm);
+    g("neck-base girth", d.neck_base_girth_mm);
     g("shoulder width", d.shoulder_width_mm);
+    g("across shoulder", d.across_shoulder_mm);
     b("shoulder slope", &d.shoulder_slope_deg, "deg");
+    g("across back", d.across_back_mm);
+    g("across front", d.across_front_mm);
     for (name, girth) in [
         ("chest", m.measurements.chest),
         ("waist", m.measurements.waist),

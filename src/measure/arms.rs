@@ -13,10 +13,11 @@
 //! close to horizontal has no such loops: its measurements are absent.
 
 use super::dimensions::Bilateral;
+use super::plane::PlaneLoop;
 use crate::mesh::Mesh;
 use crate::regions::{BodyRegions, Region};
-use crate::slice::{Contour, sections};
-use glam::{DQuat, DVec2, DVec3};
+use crate::slice::Contour;
+use glam::{DVec2, DVec3};
 use serde::Serialize;
 
 /// Spacing of the arm's loops (mm).
@@ -104,15 +105,7 @@ fn arm_loops(
 /// The tape girth of `body`'s section by the plane through `centre` perpendicular to `axis`:
 /// the loop around `centre` (or the one whose centroid is nearest), hulled.
 fn girth_across(body: &Mesh, centre: DVec3, axis: DVec3) -> f64 {
-    let turn = DQuat::from_rotation_arc(axis.normalize(), DVec3::Z);
-    let turned = body.map_positions(|p| turn * (p - centre));
-    let section = sections(&turned, &[0.0]).swap_remove(0);
-    let distance = |c: &Contour| if c.contains(DVec2::ZERO) { 0.0 } else { c.centroid().length() };
-    section
-        .loops
-        .iter()
-        .min_by(|a, b| distance(a).total_cmp(&distance(b)))
-        .map_or(0.0, Contour::tape_girth)
+    PlaneLoop::around(body, centre, axis).map_or(0.0, |l| l.contour.tape_girth())
 }
 
 /// The girth perpendicular to unit `axis` of the horizontal `loop_` at height `z`, through its

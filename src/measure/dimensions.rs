@@ -4,6 +4,7 @@
 //! check it with a tape; lengths in millimetres, angles in degrees, heights above the floor.
 
 use super::arms::{arms, bilateral};
+use super::neck_and_shoulders::{midline_profile, neck_and_shoulders};
 use super::{Levels, deepest_fold, forward};
 use crate::mesh::Mesh;
 use crate::regions::{BodyRegions, Region};
@@ -36,9 +37,22 @@ pub struct BodyDimensions {
     /// Neck girth: the tape girth of the neck at its narrowest level between the shoulders
     /// and the head (horizontal).
     pub neck_girth_mm: f64,
+    /// Neck-base girth: around the base of the neck through the front neck point (jugular
+    /// notch), both side neck points and the back neck point (cervicale), in their plane
+    /// ([`crate::measure::NeckAndShoulders`]).
+    pub neck_base_girth_mm: f64,
     /// Shoulder width (biacromial breadth): the horizontal distance between the two shoulder
     /// points (acromions), found as the armholes' shoulder points.
     pub shoulder_width_mm: f64,
+    /// Across shoulder: from one shoulder point to the other over the back of the neck base,
+    /// along the surface in the plane through both shoulder points and the back neck point.
+    pub across_shoulder_mm: f64,
+    /// Across back: horizontally across the back from armhole to armhole, half way up the
+    /// armholes, between the arm plates ([`crate::measure::NeckAndShoulders`]); NaN (null in
+    /// JSON) where a plate does not cut the torso there.
+    pub across_back_mm: f64,
+    /// Across front: as across back, over the front.
+    pub across_front_mm: f64,
     /// Shoulder slope: the angle below horizontal of the line from the side of the neck (the
     /// neck section's outermost point at the neck level) to the shoulder point.
     pub shoulder_slope_deg: Bilateral,
@@ -106,9 +120,6 @@ const UNDERBUST_SPAN: f64 = 0.10;
 const MIN_FOLD_MM: f64 = 1.0;
 /// Spacing of the levels searched and of the midline profiles (mm).
 const STEP_MM: f64 = 2.0;
-/// Half-width of the band around the midline whose front- or backmost point a waist length
-/// follows (mm).
-const MIDLINE_BAND_MM: f64 = 15.0;
 
 /// `count` heights from `lo` to `hi` inclusive.
 fn heights(lo: f64, hi: f64) -> Vec<f64> {
@@ -120,24 +131,9 @@ fn tape(c: &Option<Contour>) -> f64 {
     c.as_ref().map_or(0.0, Contour::tape_girth)
 }
 
-/// The length of the torso's midline profile from `from` up to `to`: the front-most
-/// (`front`) or back-most point near the centre line at each level, joined.
+/// The length of the torso's midline profile from `from` up to `to` (front or back).
 fn midline_length(body: &Mesh, regions: &BodyRegions, from: f64, to: f64, front: bool) -> f64 {
-    let zs = heights(from, to);
-    let cx = regions.landmarks.centre_x;
-    let profile: Vec<DVec2> = zs
-        .iter()
-        .zip(regions.torso_sections(body, &zs))
-        .filter_map(|(&z, c)| {
-            let ys = c?.points.into_iter().filter(|p| (p.x - cx).abs() <= MIDLINE_BAND_MM);
-            let y = if front {
-                ys.map(|p| p.y).fold(None, |m: Option<f64>, y| Some(m.map_or(y, |m| m.min(y))))
-            } else {
-                ys.map(|p| p.y).fold(None, |m: Option<f64>, y| Some(m.map_or(y, |m| m.max(y))))
-            }?;
-            Some(DVec2::new(y, z))
-        })
-        .collect();
+    let profile = midline_profile(body, regions, from, to, front);
     profile.windows(2).map(|w| w[0].distance(w[1])).sum()
 }
 
@@ -193,11 +189,18 @@ pub fn dimensions(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> BodyDi
     let largest = |pick: fn(&(f64, f64)) -> f64| calf.iter().map(pick).fold(0.0, f64::max);
     let pair = |(l, r): (f64, f64)| Bilateral::new(l, r);
     let arms = arms(body, regions);
+    let upper = neck_and_shoulders(body, regions);
+    let upper_value =
+        |pick: fn(&super::NeckAndShoulders) -> f64| upper.as_ref().map_or(f64::NAN, pick);
 
     BodyDimensions {
         stature_mm: h,
         neck_girth_mm: neck_loop.tape_girth(),
+        neck_base_girth_mm: upper_value(|u| u.neck_base.length),
         shoulder_width_mm: (ls.x - rs.x).abs(),
+        across_shoulder_mm: upper_value(|u| u.across_shoulder.length),
+        across_back_mm: upper_value(|u| u.across_back),
+        across_front_mm: upper_value(|u| u.across_front),
         shoulder_slope_deg: Bilateral::new(slope(ls, neck_side(1.0)), slope(rs, neck_side(-1.0))),
         chest_girth_mm: tape(&main[0]),
         underbust_girth_mm: underbust,

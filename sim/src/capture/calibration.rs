@@ -112,6 +112,22 @@ pub(crate) fn tape_girth_across(body: &ImplicitBody, centre: DVec3, axis: DVec3)
     loop_in_plane(&field, centre, u, axis.cross(u)).map(|pts| perimeter(&convex_hull(&pts)))
 }
 
+/// The section of the whole surface (arms included) by the plane through `centre`
+/// perpendicular to `axis`, as points in space: [`loop_in_plane`]'s. `None` if `centre` is not
+/// inside.
+pub(crate) fn section_across(
+    body: &ImplicitBody,
+    centre: DVec3,
+    axis: DVec3,
+) -> Option<Vec<DVec3>> {
+    let axis = axis.normalize();
+    let u = axis.any_orthonormal_vector();
+    let v = axis.cross(u);
+    let field = |p: DVec3| body.value(p);
+    let offsets = loop_in_plane(&field, centre, u, v)?;
+    Some(offsets.into_iter().map(|[a, b]| centre + u * a + v * b).collect())
+}
+
 /// Perimeter of the closed polygon `pts`.
 fn perimeter(pts: &[[f64; 2]]) -> f64 {
     (0..pts.len())

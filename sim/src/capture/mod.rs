@@ -83,6 +83,15 @@ impl SyntheticBody {
         )
     }
 
+    /// The section of the surface (arms included) by the plane through `centre`
+    /// perpendicular to `axis`, in space (mm): along each of 360 rays in the plane from
+    /// `centre`, the first point where the surface is left. `None` if `centre` is not inside.
+    pub fn section_across(&self, centre: [f64; 3], axis: [f64; 3]) -> Option<Vec<[f64; 3]>> {
+        let (centre, axis) = (glam::DVec3::from_array(centre), glam::DVec3::from_array(axis));
+        calibration::section_across(&self.implicit, centre, axis)
+            .map(|points| points.into_iter().map(|p| p.to_array()).collect())
+    }
+
     /// A point on the axis of the leg on the subject's left (`left`) or right side at height
     /// `z` (on the line from the hip joint to the ankle joint): inside the leg below the crotch.
     pub fn leg_axis_at(&self, left: bool, z: f64) -> [f64; 2] {
