@@ -1,7 +1,8 @@
 //! The measurement set against what the sim generator knows: stature, inside leg and the
 //! girths (torso, neck, legs, and the arms across their axes) measured on its implicit surface
 //! at the levels the rules chose, the neck base, across shoulder, across back and across
-//! front on its implicit surface in the planes and between the landmarks the rules chose,
+//! front on its implicit surface in the planes and between the landmarks the rules chose, the
+//! calf (largest) and ankle girths, the back and front waist lengths along its midline,
 //! the shoulder width it was built with and the arm length between its joints; and `measure` on several scans at once,
 //! as CSV and JSON with the units in the keys.
 
@@ -28,6 +29,11 @@ const GIRTH_MM: f64 = 2.0;
 /// sharpest bend, which the mesh's 4 mm grid rounds most: the mesh read 0.5-3.7 mm over the
 /// implicit surface on the six bodies of the test.
 const NECK_BASE_MM: f64 = 5.0;
+/// Spacing of the levels of the waist lengths' profiles on the implicit surface (mm).
+const PROFILE_STEP_MM: f64 = 10.0;
+/// Back and front waist length (mm): the rule's profile joins the mesh's sections every 2 mm,
+/// the truth the implicit surface's every 10 mm; both follow the same points.
+const WAIST_LENGTH_MM: f64 = 3.0;
 /// Stature and inside leg (mm): the mesh's top and crotch lie within a grid cell's fraction.
 const HEIGHT_MM: f64 = 2.0;
 /// Shoulder width (mm): the generator's acromion is a design point inside a smooth blend;
@@ -72,6 +78,40 @@ fn upper_torso_truth(body: &SyntheticBody, u: &NeckAndShoulders, m: &Landmarks) 
     [neck_base, across_shoulder, back, front]
 }
 
+/// The length of the torso's front (`front`) or back midline profile on the generator's
+/// implicit surface from the waist level `from` up to the neck level `to`: at each level the
+/// front- or back-most point within the rule's band of the centre line, levels
+/// [`PROFILE_STEP_MM`] apart (a smooth profile: finer steps change the length by far less
+/// than the tolerance).
+fn midline_truth(body: &SyntheticBody, centre_x: f64, from: f64, to: f64, front: bool) -> f64 {
+    let count = ((to - from) / PROFILE_STEP_MM).ceil() as usize;
+    let sign = if front { -1.0 } else { 1.0 };
+    let profile: Vec<DVec2> = (0..=count)
+        .map(|k| {
+            let z = from + (to - from) * k as f64 / count as f64;
+            let c = body.torso_centre_at(z);
+            let points =
+                body.section_across([c[0], c[1], z], [0.0, 0.0, 1.0]).expect("inside the torso");
+            let y = (points.iter())
+                .filter(|p| (p[0] - centre_x).abs() <= dressform::measure::MIDLINE_BAND_MM)
+                .map(|p| sign * p[1])
+                .fold(f64::NEG_INFINITY, f64::max);
+            DVec2::new(sign * y, z)
+        })
+        .collect();
+    profile.windows(2).map(|w| w[0].distance(w[1])).sum()
+}
+
+/// The largest girth of a leg on the implicit surface between `lo` and `hi`: every 10 mm, then
+/// every 2 mm (the rule's step) around the largest.
+fn calf_truth(leg: &dyn Fn(f64) -> f64, lo: f64, hi: f64) -> f64 {
+    let best = |zs: Vec<f64>| {
+        zs.into_iter().map(|z| (leg(z), z)).max_by(|a, b| a.0.total_cmp(&b.0)).expect("levels")
+    };
+    let coarse = best((0..).map(|k| lo + 10.0 * k as f64).take_while(|&z| z <= hi).collect());
+    best((-5..=5).map(|k| (coarse.1 + 2.0 * k as f64).clamp(lo, hi)).collect()).0
+}
+
 /// (name, measured, known) for one body.
 fn compare(
     body: &SyntheticBody,
@@ -109,10 +149,24 @@ fn compare(
     rows.push(("across shoulder".into(), d.across_shoulder_mm, across_shoulder));
     rows.push(("across back".into(), d.across_back_mm, across_back));
     rows.push(("across front".into(), d.across_front_mm, across_front));
+    let m = upper.1;
+    for (front, name, value) in [
+        (false, "back waist length", d.back_waist_length_mm),
+        (true, "front waist length", d.front_waist_length_mm),
+    ] {
+        rows.push((
+            name.into(),
+            value,
+            midline_truth(body, m.centre_x, d.waist_height_mm, neck, front),
+        ));
+    }
     for (left, name) in [(true, "left"), (false, "right")] {
         let pick = |b: &dressform::measure::Bilateral| if left { b.left } else { b.right };
         rows.push((format!("{name} thigh"), pick(&d.thigh_girth_mm), leg(left, thigh_z)));
         rows.push((format!("{name} knee"), pick(&d.knee_girth_mm), leg(left, knee_z)));
+        rows.push((format!("{name} ankle"), pick(&d.ankle_girth_mm), leg(left, m.ankle)));
+        let calf = calf_truth(&|z| leg(left, z), m.ankle, knee_z);
+        rows.push((format!("{name} calf"), pick(&d.calf_girth_mm), calf));
         // Arms: the girths across the axis where the rules took them, on the implicit
         // surface; the length against the generator's joints (shoulder point to elbow to wrist).
         let a = arm[usize::from(!left)].as_ref().expect("an A-posed arm is measured");
@@ -185,6 +239,7 @@ fn the_measurement_set_matches_what_the_generator_knows() {
             "shoulder width" => SHOULDER_MM,
             "arm length" => ARM_LENGTH_MM,
             "neck base" => NECK_BASE_MM,
+            "back waist length" | "front waist length" => WAIST_LENGTH_MM,
             _ => GIRTH_MM,
         };
         assert!(

@@ -36,7 +36,7 @@ pub use arms::{ArmMeasures, ArmSection, UPPER_ARM_OF_STATURE, WRIST_FROM_FINGERT
 pub use compare::{Comparison, MirrorRow, TableRow, compare};
 pub use dimensions::{Bilateral, BodyDimensions, KNEE_OF_CROTCH, THIGH_BELOW_CROTCH, dimensions};
 pub use neck_and_shoulders::{
-    NeckAndShoulders, PlaneMeasure, across_back_and_front, neck_and_shoulders,
+    MIDLINE_BAND_MM, NeckAndShoulders, PlaneMeasure, across_back_and_front, neck_and_shoulders,
 };
 pub use plane::{PlaneLoop, tape_arc};
 
