@@ -2,7 +2,8 @@
 //! girths (torso, neck, legs, and the arms across their axes) measured on its implicit surface
 //! at the levels the rules chose, the neck base, across shoulder, across back and across
 //! front on its implicit surface in the planes and between the landmarks the rules chose, the
-//! calf (largest) and ankle girths, the back and front waist lengths along its midline,
+//! calf (largest), ankle and underbust girths, the shoulder slopes, the back and front waist
+//! lengths along its midline,
 //! the shoulder width it was built with and the arm length between its joints; and `measure` on several scans at once,
 //! as CSV and JSON with the units in the keys.
 
@@ -11,7 +12,7 @@ use crate::common;
 use common::{dressform, mesh_of};
 use dressform::measure::{
     ArmMeasures, BodyDimensions, NeckAndShoulders, across_back_and_front, arms, dimensions, levels,
-    neck_and_shoulders, tape_arc,
+    neck_and_shoulders, tape_arc, underbust,
 };
 use dressform::output::write_atomically;
 use dressform::regions::Landmarks;
@@ -34,6 +35,9 @@ const PROFILE_STEP_MM: f64 = 10.0;
 /// Back and front waist length (mm): the rule's profile joins the mesh's sections every 2 mm,
 /// the truth the implicit surface's every 10 mm; both follow the same points.
 const WAIST_LENGTH_MM: f64 = 3.0;
+/// Shoulder slope (degrees): the side of the neck on the mesh's section and on the implicit
+/// surface's, to the same shoulder point.
+const SLOPE_DEG: f64 = 0.5;
 /// Stature and inside leg (mm): the mesh's top and crotch lie within a grid cell's fraction.
 const HEIGHT_MM: f64 = 2.0;
 /// Shoulder width (mm): the generator's acromion is a design point inside a smooth blend;
@@ -120,6 +124,7 @@ fn compare(
     crotch: f64,
     neck: f64,
     upper: (&NeckAndShoulders, &Landmarks),
+    under_z: f64,
 ) -> Vec<(String, f64, f64)> {
     let t = &body.truth;
     let torso = |z: f64| body.girth_around(body.torso_centre_at(z), z).expect("inside the torso");
@@ -150,6 +155,27 @@ fn compare(
     rows.push(("across back".into(), d.across_back_mm, across_back));
     rows.push(("across front".into(), d.across_front_mm, across_front));
     let m = upper.1;
+    // The underbust where the rule found it; the shoulder slope from the side of the implicit
+    // neck at the neck level to the shoulder points the rule found.
+    rows.push(("underbust".into(), d.underbust_girth_mm, torso(under_z)));
+    let c = body.torso_centre_at(neck);
+    let neck_loop =
+        body.section_across([c[0], c[1], neck], [0.0, 0.0, 1.0]).expect("inside the neck");
+    for (side, name, armhole, slope) in [
+        (1.0, "left", &m.left_armhole, d.shoulder_slope_deg.left),
+        (-1.0, "right", &m.right_armhole, d.shoulder_slope_deg.right),
+    ] {
+        let outer = (neck_loop.iter().map(|p| DVec3::from_array(*p)))
+            .max_by(|a, b| (side * a.x).total_cmp(&(side * b.x)))
+            .expect("a neck loop");
+        let point = armhole.shoulder_point;
+        let run = (point.truncate() - outer.truncate()).length();
+        rows.push((
+            format!("{name} shoulder slope"),
+            slope,
+            ((outer.z - point.z) / run).atan().to_degrees(),
+        ));
+    }
     for (front, name, value) in [
         (false, "back waist length", d.back_waist_length_mm),
         (true, "front waist length", d.front_waist_length_mm),
@@ -216,7 +242,8 @@ fn the_measurement_set_matches_what_the_generator_knows() {
             }
             let upper =
                 neck_and_shoulders(&mesh, &regions).expect("the neck and shoulders are found");
-            compare(&body, &d, &arms(&mesh, &regions), m.crotch, m.neck, (&upper, m))
+            let under_z = underbust(&mesh, &regions, &lv).expect("an underbust").z;
+            compare(&body, &d, &arms(&mesh, &regions), m.crotch, m.neck, (&upper, m), under_z)
                 .into_iter()
                 .map(|(n, a, b)| (seed, n, a, b))
                 .collect::<Vec<_>>()
@@ -231,7 +258,8 @@ fn the_measurement_set_matches_what_the_generator_knows() {
         }
     }
     for (name, (error, seed)) in &worst {
-        println!("{name:<15} worst {error:+7.2} mm (seed {seed})");
+        let unit = if name.ends_with("slope") { "deg" } else { "mm" };
+        println!("{name:<18} worst {error:+7.2} {unit} (seed {seed})");
     }
     for (seed, name, measured, known) in &rows {
         let tolerance = match name.trim_start_matches("left ").trim_start_matches("right ") {
@@ -240,6 +268,7 @@ fn the_measurement_set_matches_what_the_generator_knows() {
             "arm length" => ARM_LENGTH_MM,
             "neck base" => NECK_BASE_MM,
             "back waist length" | "front waist length" => WAIST_LENGTH_MM,
+            "shoulder slope" => SLOPE_DEG,
             _ => GIRTH_MM,
         };
         assert!(

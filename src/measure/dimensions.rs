@@ -5,7 +5,7 @@
 
 use super::arms::{arms, bilateral};
 use super::neck_and_shoulders::{midline_profile, neck_and_shoulders};
-use super::{Levels, deepest_fold, forward};
+use super::{Girth, Levels, deepest_fold, forward};
 use crate::mesh::Mesh;
 use crate::regions::{BodyRegions, Region};
 use crate::slice::Contour;
@@ -144,24 +144,32 @@ fn leg_girths(body: &Mesh, regions: &BodyRegions, zs: &[f64]) -> Vec<(f64, f64)>
     left.iter().zip(&right).map(|(l, r)| (tape(l), tape(r))).collect()
 }
 
+/// The underbust girth and its level: the fold under the bust, the level set farthest back
+/// behind the front-most levels both above it (the bust) and below it (ribs or belly), between
+/// the chest level and [`UNDERBUST_SPAN`] of the stature below it. Merely the level set
+/// farthest back would be the chest level itself where that lies above the bust, at the
+/// armpits (the MakeHuman base body: underbust = chest). A front without a fold keeps the
+/// level set farthest back. `None` if the torso has no loops there.
+pub fn underbust(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> Option<Girth> {
+    let h = regions.landmarks.height;
+    let under = heights(levels.chest - UNDERBUST_SPAN * h, levels.chest);
+    let profile: Vec<(f64, Contour)> = (under.iter().copied())
+        .zip(regions.torso_sections(body, &under))
+        .filter_map(|(z, c)| Some((z, c?)))
+        .collect();
+    let fronts: Vec<f64> = profile.iter().map(|(_, c)| forward(c)).collect();
+    let set_back = || (0..profile.len()).min_by(|&a, &b| fronts[a].total_cmp(&fronts[b]));
+    let k = deepest_fold(&fronts, MIN_FOLD_MM).map(|(k, _)| k).or_else(set_back)?;
+    Some(Girth::of(profile[k].0, &profile[k].1))
+}
+
 /// The body dimensions of `body`, segmented as `regions`, with its measurement `levels`.
 pub fn dimensions(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> BodyDimensions {
     let m = &regions.landmarks;
     let h = m.height;
     let torso = |zs: &[f64]| regions.torso_sections(body, zs);
 
-    // Underbust: the fold under the bust, the level set farthest back behind the front-most
-    // levels both above it (the bust) and below it (ribs or belly). Merely the level set
-    // farthest back would be the chest level itself where that lies above the bust, at the
-    // armpits (the MakeHuman base body: underbust = chest). A front without a fold keeps
-    // the level set farthest back.
-    let under = heights(levels.chest - UNDERBUST_SPAN * h, levels.chest);
-    let profile: Vec<(f64, f64)> =
-        torso(&under).iter().flatten().map(|c| (forward(c), c.tape_girth())).collect();
-    let fronts: Vec<f64> = profile.iter().map(|l| l.0).collect();
-    let set_back = || (0..profile.len()).min_by(|&a, &b| fronts[a].total_cmp(&fronts[b]));
-    let fold = deepest_fold(&fronts, MIN_FOLD_MM).map(|(k, _)| k).or_else(set_back);
-    let underbust = fold.map_or(0.0, |k| profile[k].1);
+    let underbust = underbust(body, regions, levels).map_or(0.0, |g| g.tape);
 
     let main =
         torso(&[levels.chest, levels.waist, 0.5 * (levels.waist + levels.hip), levels.hip, m.neck]);

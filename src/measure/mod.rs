@@ -34,7 +34,9 @@ mod plane;
 
 pub use arms::{ArmMeasures, ArmSection, UPPER_ARM_OF_STATURE, WRIST_FROM_FINGERTIP, arms};
 pub use compare::{Comparison, MirrorRow, TableRow, compare};
-pub use dimensions::{Bilateral, BodyDimensions, KNEE_OF_CROTCH, THIGH_BELOW_CROTCH, dimensions};
+pub use dimensions::{
+    Bilateral, BodyDimensions, KNEE_OF_CROTCH, THIGH_BELOW_CROTCH, dimensions, underbust,
+};
 pub use neck_and_shoulders::{
     MIDLINE_BAND_MM, NeckAndShoulders, PlaneMeasure, across_back_and_front, neck_and_shoulders,
 };
@@ -77,7 +79,7 @@ pub struct Girth {
 }
 
 impl Girth {
-    fn of(z: f64, c: &Contour) -> Girth {
+    pub(crate) fn of(z: f64, c: &Contour) -> Girth {
         Girth { z, tape: c.tape_girth(), contour: c.perimeter() }
     }
 }
