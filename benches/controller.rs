@@ -43,8 +43,9 @@ async fn update(form: &FormDescription, setpoints: &SetPoints, bus: &mut SimBus)
 }
 
 fn cpu_time() -> Duration {
-    // SAFETY: getrusage writes into the zeroed struct we own.
+    // SAFETY: `rusage` is a plain C struct of integers, for which all-zero bytes are valid.
     let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: getrusage writes into the struct we own, through a valid exclusive pointer.
     unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) };
     let micros = |t: libc::timeval| t.tv_sec as u64 * 1_000_000 + t.tv_usec as u64;
     Duration::from_micros(micros(usage.ru_utime) + micros(usage.ru_stime))
