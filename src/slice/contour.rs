@@ -23,6 +23,19 @@ impl Contour {
     }
 
     /// Tape girth: the perimeter of the convex hull, what a tape measure laid around reads.
+    ///
+    /// ```
+    /// use dressform::slice::Contour;
+    /// use glam::DVec2;
+    ///
+    /// // A 100 mm square with a notch 30 mm deep in one side: the tape bridges the notch.
+    /// let points = [(0., 0.), (100., 0.), (100., 100.), (60., 100.), (50., 70.), (40., 100.), (0., 100.)]
+    ///     .map(|(x, y)| DVec2::new(x, y))
+    ///     .to_vec();
+    /// let notched = Contour { points };
+    /// assert!((notched.tape_girth() - 400.0).abs() < 1e-9);
+    /// assert!(notched.perimeter() > 400.0); // the contour itself follows the notch
+    /// ```
     pub fn tape_girth(&self) -> f64 {
         let hull = convex_hull(&self.points);
         Contour { points: hull }.perimeter()

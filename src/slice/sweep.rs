@@ -58,6 +58,25 @@ fn segment(mesh: &Mesh, tri: [u32; 3], h: f64) -> Segment {
 
 /// Cross-sections of `mesh` at each of `heights` (any order; returned in the same order). A
 /// height that is not a finite number crosses nothing: its section is empty.
+///
+/// ```
+/// use dressform::mesh::Mesh;
+/// use dressform::slice::sections;
+/// use glam::DVec3;
+///
+/// // A closed cube, 100 mm on a side, standing on the floor.
+/// let corners = (0..8)
+///     .map(|i| DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64) * 100.0)
+///     .collect();
+/// let faces = [[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
+///              [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]];
+/// let cube = Mesh::new(corners, faces.to_vec());
+///
+/// let cut = sections(&cube, &[50.0, 150.0]);
+/// assert_eq!(cut[0].loops.len(), 1); // one loop around the cube at 50 mm
+/// assert!((cut[0].loops[0].perimeter() - 400.0).abs() < 1e-9);
+/// assert!(cut[1].loops.is_empty()); // nothing above the cube
+/// ```
 pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
     let mut order: Vec<usize> = (0..heights.len()).filter(|&i| heights[i].is_finite()).collect();
     order.sort_by(|&a, &b| heights[a].total_cmp(&heights[b]));
