@@ -72,11 +72,7 @@ fn mirrored_half(c: &Contour, axis: f64, left: bool) -> (f64, f64) {
 }
 
 fn width(c: &Contour) -> f64 {
-    let (lo, hi) = c
-        .points
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)));
-    hi - lo
+    c.bounds().map_or(0.0, |b| b.size().x)
 }
 
 /// Compares `body` (with its `regions`) and its `mannequin` at the body's measurement

@@ -42,13 +42,6 @@ fn follow(
     out
 }
 
-/// Horizontal extent of a loop: (min x, max x).
-fn x_range(c: &Contour) -> (f64, f64) {
-    c.points
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)))
-}
-
 /// The part of `body` between the heights `below` and `above`: all a bisection between two
 /// tracking levels needs to cut.
 fn between(body: &Mesh, below: f64, above: f64) -> Mesh {
@@ -140,7 +133,7 @@ fn refine_outgrowth(
     sign: f64,
 ) -> DVec3 {
     let near = between(body, below, above);
-    let (torso_c, centre) = (torso.centroid(), bbox_centre_x(torso));
+    let (torso_c, centre) = (torso.centroid(), torso.bbox_centre().x);
     let limit = reach(torso, sign, centre) + ARM_JUMP_MM;
     let mut apart = torso.clone();
     while above - below > 0.1 {
@@ -162,12 +155,6 @@ fn refine_outgrowth(
 /// Whether loop `a` overlaps loop `b` seen from above: a point of `a` lies inside `b`.
 fn overlaps(a: &Contour, b: &Contour) -> bool {
     a.points.iter().any(|&p| b.contains(p))
-}
-
-/// The x of the middle of a loop's bounding box.
-fn bbox_centre_x(c: &Contour) -> f64 {
-    let (lo, hi) = x_range(c);
-    0.5 * (lo + hi)
 }
 
 /// Tracks loops through `sections`, the body's sections every `step` mm from `floor` (at
@@ -243,7 +230,7 @@ pub(super) fn track(
         up.windows(2).find_map(|w| {
             let ((i, t), (j, t_next)) = (w[0], w[1]);
             let torso_here = &sections[i].loops[t];
-            let centre = bbox_centre_x(torso_here);
+            let centre = torso_here.bbox_centre().x;
             let next = &sections[j].loops[t_next];
             let mut beside = (0..sections[i].loops.len())
                 .filter(|&k| k != t)
@@ -263,7 +250,7 @@ pub(super) fn track(
     };
     // The centre line: the torso's bounding-box centre just below the lower armpit.
     let (i, t, _) = if left.0 <= right.0 { left } else { right };
-    let centre_x = bbox_centre_x(&sections[i].loops[t]);
+    let centre_x = sections[i].loops[t].bbox_centre().x;
     let armpit_point = |(i, t, how): (usize, usize, Join), sign: f64| {
         let torso_loop = &sections[i].loops[t];
         match how {

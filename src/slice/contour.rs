@@ -1,5 +1,6 @@
 //! One closed loop of a cross-section and what a tailor measures on it.
 
+use crate::mesh::Aabb;
 use glam::DVec2;
 
 /// A closed polygon in a horizontal plane (the last point connects back to the first),
@@ -20,6 +21,17 @@ impl Contour {
     /// Length of the contour itself (follows every concavity).
     pub fn perimeter(&self) -> f64 {
         self.edges().map(|(a, b)| a.distance(b)).sum()
+    }
+
+    /// The loop's bounding box (in the plane z = 0), or `None` for a loop without points.
+    pub fn bounds(&self) -> Option<Aabb> {
+        Aabb::around(self.points.iter().map(|p| p.extend(0.0)))
+    }
+
+    /// The centre of the loop's bounding box (paper eq. 5 and eq. 9); the origin for a loop
+    /// without points.
+    pub fn bbox_centre(&self) -> DVec2 {
+        self.bounds().map_or(DVec2::ZERO, |b| (0.5 * (b.min + b.max)).truncate())
     }
 
     /// Tape girth: the perimeter of the convex hull, what a tape measure laid around reads.
