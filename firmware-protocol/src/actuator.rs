@@ -131,9 +131,10 @@ impl Position {
         self.0
     }
 
-    /// The position in millimetres.
-    pub fn mm(self) -> f32 {
-        f32::from(self.0) / 100.0
+    /// The position in millimetres (exactly the nearest `f64` to the decimal value: the one
+    /// conversion from the wire's hundredths the host uses).
+    pub fn mm(self) -> f64 {
+        f64::from(self.0) / 100.0
     }
 }
 

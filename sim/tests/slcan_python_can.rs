@@ -9,7 +9,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use sim::form::reference;
+use form_description::reference;
 use sim::serve::{ServeConfig, Transport, serve};
 
 fn python_can_available() -> bool {

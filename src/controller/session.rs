@@ -34,8 +34,8 @@
 //! [`super::faults`]).
 //!
 //! Safety: the session never sends targets itself; `motion` builds them from
-//! [`SafeTarget`](super::safety::SafeTarget)s only. Every packet goes through the link's
-//! [`Gate`](super::estop::Gate): once the link is e-stopped, from any thread, nothing else is
+//! [`SafeTarget`](crate::safety::SafeTarget)s only. Every packet goes through the link's
+//! [`Gate`](super::transport::Gate): once the link is e-stopped, from any thread, nothing else is
 //! sent and the session ends with [`SessionError::Stopped`]. Every way out of a failed move
 //! goes through a broadcast `Halt` or `EmergencyStop`.
 
@@ -44,18 +44,19 @@ use std::time::Duration;
 
 use firmware_protocol::actuator::MAX_ACTUATORS;
 use firmware_protocol::drive::{AckStatus, DriveCommand, DriveState, EmergencyCode, Faults};
-use firmware_protocol::message::{Capabilities, Emergency, Heartbeat, HostHeartbeat, Identity};
+use firmware_protocol::message::{
+    Capabilities, Emergency, Heartbeat, HostHeartbeat, Identity, Positions8,
+};
 use firmware_protocol::version::Compatibility;
 use firmware_protocol::{
     ActuatorSet, Address, Code, Link, Message, NodeId, PROTOCOL_VERSION, Packet, Position, timing,
 };
-use sim::form::FormDescription;
+use form_description::FormDescription;
 use tokio::sync::watch;
 use tokio::time::{Instant, sleep_until};
 
-use super::estop::StopCause;
 use super::faults::{self, Fault, NodeName};
-use super::transport::{Transport, TransportError};
+use super::transport::{StopCause, Transport, TransportError};
 
 /// The host heartbeat period on CAN.
 pub const HEARTBEAT_PERIOD: Duration =
@@ -69,7 +70,7 @@ pub const NODE_LOST_AFTER: Duration = Duration::from_millis(timing::NODE_LOST_AF
 pub const POLLS_LOST: u32 = (timing::NODE_LOST_AFTER_MS / timing::HEARTBEAT_PERIOD_MS) as u32;
 /// How long the whole link may carry nothing before its silence is blamed on the nodes (CAN)
 /// or requests time out regardless: the longest stall of a pseudo-terminal measured on a
-/// loaded 2-core machine (1.3 s, the kernel holding every pty's bytes; see `sim::bus::pty`),
+/// loaded 2-core machine (1.3 s, the kernel holding every pty's bytes; see the simulator's `bus/pty.rs`),
 /// with margin. A single silent node is still found within [`NODE_LOST_AFTER`], since the
 /// others keep talking.
 pub const LINK_STALL_LIMIT: Duration = Duration::from_secs(2);
@@ -301,7 +302,7 @@ fn answer_timeout(link: Link) -> Duration {
 
 impl<T: Transport> Session<T> {
     /// A session with `form`'s nodes over `transport`; nothing is sent yet. Once the link is
-    /// e-stopped (see [`Gate`](super::estop::Gate)) the session fails with
+    /// e-stopped (see [`Gate`](super::transport::Gate)) the session fails with
     /// [`SessionError::Stopped`].
     pub fn new(transport: T, form: &FormDescription) -> Self {
         let nodes = form.node_ids().map(|n| (n, NodeStatus::default())).collect();
@@ -399,8 +400,9 @@ impl<T: Transport> Session<T> {
                 status.heartbeat_at = Some(Instant::now());
             }
             Message::Feedback(four) => {
-                let first = four.half.first();
-                status.positions[first..first + 4].copy_from_slice(&four.positions);
+                let mut all = Positions8 { positions: status.positions };
+                all.set_half(&four);
+                status.positions = all.positions;
             }
             Message::AllFeedback(all) => status.positions = all.positions,
             Message::Emergency(e) => status.events.push(e),
@@ -467,7 +469,7 @@ impl<T: Transport> Session<T> {
     /// heard before it began and how long the host's write of it took. It does not while the
     /// link is stalled (the write slept in the kernel longer than an answer may take, or
     /// nothing at all was heard meanwhile: on a loaded machine the tty layer can hold every
-    /// pty's bytes for a second, see `sim::bus::pty`), for up to [`LINK_STALL_LIMIT`] in a
+    /// pty's bytes for a second, see the simulator's `bus/pty.rs`), for up to [`LINK_STALL_LIMIT`] in a
     /// row: a dead link, or a host whose every write sleeps, is still reported.
     fn silence_counts(&mut self, heard_before: u64, wrote_for: Duration) -> bool {
         let stalled = wrote_for > answer_timeout(self.link()) || self.heard_count == heard_before;
@@ -692,7 +694,7 @@ impl<T: Transport> Session<T> {
             identity.actuator_count.to_string(),
             actuators.len().to_string(),
         );
-        let weakest = |f: &dyn Fn(&sim::form::ActuatorSpec) -> u16| {
+        let weakest = |f: &dyn Fn(&form_description::ActuatorSpec) -> u16| {
             actuators.iter().map(|a| f(a)).min().unwrap_or(0)
         };
         let stroke = weakest(&|a| a.stroke().hundredths_mm());

@@ -184,7 +184,7 @@ impl ActuatorSim {
     pub fn start_move(&mut self, now: Instant, target: Position, duration_ms: u16) -> Option<u32> {
         let (p0, v0) = self.planned(now);
         let limits = self.limits();
-        let p1 = f64::from(target.hundredths_mm()) / 100.0;
+        let p1 = target.mm();
         let fastest = Profile::fastest(p0, v0, p1, limits);
         let required_ms = if v0 == 0.0 {
             // From rest host and node share one integer formula.
