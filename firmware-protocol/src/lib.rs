@@ -54,7 +54,7 @@ pub mod timing;
 pub mod update;
 pub mod version;
 
-pub use actuator::{Actuator, ActuatorSet, Position};
+pub use actuator::{Accel, Actuator, ActuatorSet, Position, Speed};
 pub use error::Error;
 pub use message::{Address, Code, Message, NodeId, Packet};
 pub use version::{PROTOCOL_VERSION, ProtocolVersion};

@@ -21,7 +21,7 @@ use std::time::Duration;
 use firmware_protocol::actuator::MAX_ACTUATORS;
 use firmware_protocol::message::Sync;
 use firmware_protocol::update::{NodeTargets, packets, shortest_duration_ms};
-use firmware_protocol::{Actuator, Message, NodeId, Packet};
+use firmware_protocol::{Accel, Actuator, Message, NodeId, Packet, Speed};
 use serde::Serialize;
 use tokio::time::Instant;
 
@@ -43,10 +43,10 @@ pub struct PlannedTarget {
     pub actuator: Actuator,
     /// Where it goes.
     pub target: SafeTarget,
-    /// Speed limit, 0.01 mm/s.
-    pub max_speed: u16,
-    /// Acceleration limit, 0.1 mm/s².
-    pub max_accel: u16,
+    /// Speed limit.
+    pub max_speed: Speed,
+    /// Acceleration limit.
+    pub max_accel: Accel,
     /// Stroke, 0.01 mm (the distance assumed when the position is unknown).
     pub stroke: u16,
 }

@@ -49,7 +49,7 @@ use firmware_protocol::message::{
 };
 use firmware_protocol::version::Compatibility;
 use firmware_protocol::{
-    ActuatorSet, Address, Code, Link, Message, NodeId, PROTOCOL_VERSION, Packet, Position, timing,
+    ActuatorSet, Address, Link, Message, NodeId, PROTOCOL_VERSION, Packet, Position, timing,
 };
 use form_description::FormDescription;
 use tokio::sync::watch;
@@ -291,6 +291,17 @@ pub const ATTEMPTS: u8 = timing::RETRIES + 3;
 /// again.
 const REENABLES: usize = 2;
 
+/// A request's name for people: a drive command's own name (`Enable`), else its code's.
+fn request_name(request: &Message) -> &'static str {
+    match request {
+        Message::Control(DriveCommand::Disable) => "Disable",
+        Message::Control(DriveCommand::Enable) => "Enable",
+        Message::Control(DriveCommand::FaultReset) => "FaultReset",
+        Message::Control(DriveCommand::Halt) => "Halt",
+        other => other.code().name(),
+    }
+}
+
 /// How long to wait for an answer before retrying.
 fn answer_timeout(link: Link) -> Duration {
     match link {
@@ -504,18 +515,18 @@ impl<T: Transport> Session<T> {
         Ok(())
     }
 
-    /// Sends `packet` (addressed to `node`) until an answer for which `answered` holds comes
-    /// from it, up to [`ATTEMPTS`] times (attempts while the link stalls do not count).
-    async fn request(
-        &mut self,
-        packet: Packet,
-        name: &'static str,
-        mut answered: impl FnMut(&Message) -> bool,
-    ) -> Result<Message, SessionError> {
+    /// Sends `packet` (addressed to `node`) until its node has sent every answer the code
+    /// table names for it ([`Code::answers`]), or an `Ack` naming it; up to
+    /// [`ATTEMPTS`] times (attempts while the link stalls do not count). Returns the last
+    /// answer.
+    async fn request(&mut self, packet: Packet) -> Result<Message, SessionError> {
         let node = match packet.address {
             Address::Node(n) => n,
             Address::Broadcast => NodeId::MIN,
         };
+        let request = packet.message;
+        // What is still awaited; an answer heard in an earlier attempt counts.
+        let mut awaited = request.code().answers().to_vec();
         let attempts = ATTEMPTS;
         let mut made = 0;
         while made < attempts {
@@ -525,7 +536,11 @@ impl<T: Transport> Session<T> {
             let deadline = Instant::now() + answer_timeout(self.link());
             let answer = self
                 .receive_until(deadline, |p| {
-                    p.address == Address::Node(node) && answered(&p.message)
+                    if p.address != Address::Node(node) || !p.message.answers(&request) {
+                        return false;
+                    }
+                    awaited.retain(|&code| code != p.message.code());
+                    awaited.is_empty() || matches!(p.message, Message::Ack(_))
                 })
                 .await?;
             if let Some(answer) = answer {
@@ -536,7 +551,7 @@ impl<T: Transport> Session<T> {
                 made += 1;
             }
         }
-        Err(SessionError::NoAnswer { node: node.get(), request: name, attempts })
+        Err(SessionError::NoAnswer { node: node.get(), request: request_name(&request), attempts })
     }
 
     /// Host heartbeats (CAN) or polls (serial) when due.
@@ -643,24 +658,13 @@ impl<T: Transport> Session<T> {
             status.identity = None;
             status.capabilities = None;
         }
-        let answer = self
-            .request(Packet::node(node, Message::IdentifyRequest), "IdentifyRequest", |m| {
-                matches!(m, Message::Capabilities(_))
-            })
-            .await;
-        match answer {
+        // Both answers (Identity, then Capabilities), asking again until both are in.
+        match self.request(Packet::node(node, Message::IdentifyRequest)).await {
             Ok(_) => {}
             Err(SessionError::NoAnswer { .. }) => {
                 return Ok(vec![NodeProblem::Missing(node.get())]);
             }
             Err(e) => return Err(e),
-        }
-        // The Identity went first; if it was lost, ask again.
-        if self.nodes.get(&node).and_then(|s| s.identity).is_none() {
-            self.request(Packet::node(node, Message::IdentifyRequest), "IdentifyRequest", |m| {
-                matches!(m, Message::Identity(_))
-            })
-            .await?;
         }
         let status = self.nodes.get(&node).cloned().unwrap_or_default();
         let now = self.clock.tick();
@@ -694,26 +698,20 @@ impl<T: Transport> Session<T> {
             identity.actuator_count.to_string(),
             actuators.len().to_string(),
         );
-        let weakest = |f: &dyn Fn(&form_description::ActuatorSpec) -> u16| {
-            actuators.iter().map(|a| f(a)).min().unwrap_or(0)
-        };
-        let stroke = weakest(&|a| a.stroke().hundredths_mm());
-        mismatch(
-            "stroke",
-            format!("{} mm", f64::from(caps.stroke.hundredths_mm()) / 100.0),
-            format!("{} mm", f64::from(stroke) / 100.0),
-        );
-        let speed = weakest(&|a| a.max_speed());
+        // A node reports the weakest of its actuators.
+        let stroke = actuators.iter().map(|a| a.stroke()).min().unwrap_or_default();
+        mismatch("stroke", format!("{} mm", caps.stroke.mm()), format!("{} mm", stroke.mm()));
+        let speed = actuators.iter().map(|a| a.max_speed()).min().unwrap_or_default();
         mismatch(
             "max speed",
-            format!("{} mm/s", f64::from(caps.max_speed) / 100.0),
-            format!("{} mm/s", f64::from(speed) / 100.0),
+            format!("{} mm/s", caps.max_speed.mm_s()),
+            format!("{} mm/s", speed.mm_s()),
         );
-        let accel = weakest(&|a| a.max_accel());
+        let accel = actuators.iter().map(|a| a.max_accel()).min().unwrap_or_default();
         mismatch(
             "max acceleration",
-            format!("{} mm/s²", f64::from(caps.max_accel) / 10.0),
-            format!("{} mm/s²", f64::from(accel) / 10.0),
+            format!("{} mm/s²", caps.max_accel.mm_s2()),
+            format!("{} mm/s²", accel.mm_s2()),
         );
         problems
     }
@@ -746,17 +744,9 @@ impl<T: Transport> Session<T> {
         node: NodeId,
         command: DriveCommand,
     ) -> Result<(), SessionError> {
-        let packet = Packet::node(node, Message::Control(command));
-        let name = match command {
-            DriveCommand::Disable => "Disable",
-            DriveCommand::Enable => "Enable",
-            DriveCommand::FaultReset => "FaultReset",
-            DriveCommand::Halt => "Halt",
-        };
-        let answer = self
-            .request(packet, name, |m| matches!(m, Message::Ack(a) if a.request == Code::Control))
-            .await?;
-        self.expect_ok(node, name, answer).await
+        let message = Message::Control(command);
+        let answer = self.request(Packet::node(node, message)).await?;
+        self.expect_ok(node, request_name(&message), answer).await
     }
 
     /// Checks a request's `Ack`; a refusal names the node's state and faults as a fresh
@@ -825,13 +815,7 @@ impl<T: Transport> Session<T> {
             self.nodes.get(&node).and_then(|s| s.heartbeat).map_or(ActuatorSet::EMPTY, |h| h.homed);
         let missing: ActuatorSet = wanted.iter().filter(|&a| !homed.contains(a)).collect();
         if !missing.is_empty() {
-            let answer = self
-                .request(
-                    Packet::node(node, Message::Home(missing)),
-                    "Home",
-                    |m| matches!(m, Message::Ack(a) if a.request == Code::Home),
-                )
-                .await?;
+            let answer = self.request(Packet::node(node, Message::Home(missing))).await?;
             self.expect_ok(node, "Home", answer).await?;
             // The heartbeat that follows shows Homing; forget the old one meanwhile.
             if let Some(status) = self.nodes.get_mut(&node) {

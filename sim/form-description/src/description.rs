@@ -3,7 +3,7 @@
 
 use std::ops::Deref;
 
-use firmware_protocol::{Actuator, NodeId, Position};
+use firmware_protocol::{Accel, Actuator, NodeId, Position, Speed};
 use serde::{Deserialize, Serialize};
 
 /// A robotic dress form that passed validation: its nodes, the rings its actuators sit on,
@@ -162,15 +162,14 @@ impl ActuatorSpec {
         Position::from_mm(self.stroke_mm as f32).unwrap_or(Position::ZERO)
     }
 
-    /// The speed limit in the protocol's unit, 0.01 mm/s.
-    pub fn max_speed(&self) -> u16 {
-        // `as` saturates (and maps NaN to 0); validation keeps the value in range.
-        (self.max_speed_mm_s * 100.0).round() as u16
+    /// The speed limit in the protocol's unit (validation keeps it in range).
+    pub fn max_speed(&self) -> Speed {
+        Speed::from_mm_s(self.max_speed_mm_s).unwrap_or_default()
     }
 
-    /// The acceleration limit in the protocol's unit, 0.1 mm/s².
-    pub fn max_accel(&self) -> u16 {
-        (self.max_accel_mm_s2 * 10.0).round() as u16
+    /// The acceleration limit in the protocol's unit (validation keeps it in range).
+    pub fn max_accel(&self) -> Accel {
+        Accel::from_mm_s2(self.max_accel_mm_s2).unwrap_or_default()
     }
 
     /// Its node's id, if the address is valid.

@@ -290,8 +290,8 @@ pub fn node_config(
         .into_iter()
         .map(|a| ActuatorConfig {
             stroke: a.stroke(),
-            max_speed: a.max_speed(),
-            max_accel: a.max_accel(),
+            max_speed: a.max_speed().hundredths_mm_s(),
+            max_accel: a.max_accel().tenths_mm_s2(),
             start_mm: options.start_position_mm.max(0.0).min(a.stroke_mm),
         })
         .collect();
