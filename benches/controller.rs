@@ -18,8 +18,8 @@ use dressform::setpoints::SetPoints;
 use firmware_protocol::Link;
 use firmware_protocol::message::Sync;
 use firmware_protocol::update::packets;
+use form_description::{FormDescription, reference};
 use sim::bus::can::{CanBus, CanKind};
-use sim::form::{FormDescription, reference};
 
 fn setpoints(form: &FormDescription) -> SetPoints {
     let positions: BTreeMap<String, f64> = form

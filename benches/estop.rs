@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 
 use criterion::{Criterion, SamplingMode, criterion_group, criterion_main};
 use firmware_protocol::drive::Faults;
-use sim::form::reference;
+use form_description::reference;
 use sim::serve::{ServeConfig, Server, Transport, serve};
 
 /// Tries per link.

@@ -19,6 +19,7 @@
 //! - [`output`]: atomic file writes and all-or-nothing output sets;
 //! - [`messages`]: how problems are worded (one bounded line each);
 //! - [`setpoints`]: the set-point file (actuator id → extension, mm) the controller drives to;
+//! - [`safety`]: [`safety::SafeTarget`], the only way a target reaches the wire;
 //! - [`controller`]: the host controller: drives the robotic form over serial, slcan, SocketCAN or the simulated bus;
 //! - [`makehuman`]: the CC0 MakeHuman assets (base mesh, targets, 163-bone rig, weights) and posing them;
 //! - [`skinning`]: linear blend skinning (eq. 3) and its angle convention;
@@ -44,6 +45,7 @@ pub mod reconstruct;
 pub mod regions;
 pub mod report;
 pub mod rig_transfer;
+pub mod safety;
 pub mod scan;
 pub mod setpoints;
 pub mod skinning;

@@ -26,14 +26,14 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use form_description::FormDescription;
 use serde::de::{Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, Serialize};
-use sim::form::FormDescription;
 
-use crate::controller::safety::SafeTarget;
 use crate::input::{self, InputError};
 use crate::messages;
 use crate::output::{WriteError, write_atomically};
+use crate::safety::SafeTarget;
 
 /// The `format` of the files this module reads and writes.
 pub const FORMAT: &str = "dressform-setpoints/1";
@@ -204,9 +204,7 @@ impl SetPoints {
                     checked.clamped.push((id.clone(), asked, target.mm()));
                     checked.targets.insert(id.clone(), target);
                 }
-                None => {
-                    offending.push((id.clone(), asked, f64::from(stroke.hundredths_mm()) / 100.0))
-                }
+                None => offending.push((id.clone(), asked, stroke.mm())),
             }
         }
         if offending.is_empty() { Ok(checked) } else { Err(OutOfStroke { offending }) }

@@ -20,7 +20,7 @@ fn setpoints(dir: &tempfile::TempDir, positions: &str) -> String {
 fn drive_on_the_simulated_form_reports_every_actuator() {
     let dir = tempfile::tempdir().unwrap();
     let file = setpoints(&dir, r#""chest-l1": 3.5, "neck-front": 2.0"#);
-    let form = concat!(env!("CARGO_MANIFEST_DIR"), "/sim/forms/reference.toml");
+    let form = concat!(env!("CARGO_MANIFEST_DIR"), "/sim/form-description/forms/reference.toml");
     let out = dressform(&["drive", &file, "--form", form, "--sim", "--json"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
@@ -92,8 +92,8 @@ fn the_builtin_form_serves_every_command() {
     let out = dressform(&["form", "show", "--toml"]);
     assert!(out.status.success());
     let toml = String::from_utf8_lossy(&out.stdout);
-    let form = sim::form::FormDescription::from_toml_str(&toml).unwrap();
-    assert_eq!(form, sim::form::reference());
+    let form = form_description::FormDescription::from_toml_str(&toml).unwrap();
+    assert_eq!(form, form_description::reference());
     let out = dressform(&["form", "show"]);
     let summary = String::from_utf8_lossy(&out.stdout);
     assert!(summary.contains("form \"reference\": 8 nodes, 9 rings, 64 actuators"), "{summary}");

@@ -12,7 +12,7 @@ use dressform::controller::{Connection, DriveOptions, LinkSpec, Transport, drive
 use dressform::setpoints::SetPoints;
 use firmware_protocol::NodeId;
 use firmware_protocol::drive::{DriveCommand, Faults};
-use sim::form::reference;
+use form_description::reference;
 use sim::serve::{ServeConfig, Server, Transport as Served, serve};
 use tokio::runtime::Runtime;
 use tokio::time::{Duration, Instant};

@@ -11,10 +11,10 @@ use dressform::controller::transport::sim::SimBus;
 use dressform::controller::{DriveOptions, Gate, Transport, TransportError, drive};
 use dressform::setpoints::SetPoints;
 use firmware_protocol::{Address, Link, Message, Packet};
+use form_description::{FormDescription, reference};
 use proptest::prelude::*;
 use sim::bus::can::{CanBus, CanKind};
 use sim::fault::FaultSpec;
-use sim::form::{FormDescription, reference};
 use sim::robot::{SimOptions, SimulatedForm};
 
 /// The simulated bus, keeping a copy of everything the host sends.
@@ -112,11 +112,12 @@ proptest! {
     ) {
         // The form, with each node's strokes scaled (the thighs, nodes 7 and 8, alike: they
         // mirror each other).
-        let mut form = reference();
-        for a in &mut form.actuators {
+        let mut spec = reference().into_spec();
+        for a in &mut spec.actuators {
             let factor = strokes[usize::from(a.node.min(7)) - 1];
             a.stroke_mm = (a.stroke_mm * factor * 100.0).round() / 100.0;
         }
+        let form = FormDescription::try_from(spec).unwrap();
         let ids: Vec<String> = form.actuators.iter().map(|a| a.id.clone()).collect();
         let positions: BTreeMap<String, f64> =
             picks.iter().map(|(&i, &mm)| (ids[i].clone(), mm)).collect();

@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 
 use dressform::input::InputError;
 use dressform::setpoints::{FORMAT, SetPoints};
-use sim::form::reference;
+use form_description::reference;
 
 fn write(dir: &tempfile::TempDir, text: &str) -> std::path::PathBuf {
     let path = dir.path().join("setpoints.json");

@@ -14,9 +14,9 @@ use dressform::controller::{
 };
 use dressform::setpoints::SetPoints;
 use firmware_protocol::drive::{DriveState, Faults};
+use form_description::{FormDescription, reference};
 use sim::bus::can::{CanBus, CanKind};
 use sim::fault::FaultSpec;
-use sim::form::{FormDescription, reference};
 use sim::robot::{SimOptions, SimulatedForm};
 use tokio::time::Instant;
 
@@ -228,7 +228,7 @@ async fn nodes_that_differ_from_the_description_are_named() {
         SimulatedForm::on_can(&real, &bus, &FaultSpec::default(), &SimOptions::default()).unwrap();
     // The host's description: node 2's strokes differ, node 9 does not exist, node 8 is left
     // out (so it is unexpected).
-    let mut described = real.clone();
+    let mut described = real.clone().into_spec();
     for a in described.actuators.iter_mut().filter(|a| a.node == 2) {
         a.stroke_mm = 55.0;
     }
@@ -238,6 +238,7 @@ async fn nodes_that_differ_from_the_description_are_named() {
     for n in described.nodes.iter_mut().filter(|n| n.address == 8) {
         n.address = 9;
     }
+    let described = FormDescription::try_from(described).unwrap();
     let setpoints = SetPoints::new(real.name.clone(), BTreeMap::new());
     let error = dressform::controller::drive(
         SimBus::attach(&bus),

@@ -42,7 +42,7 @@ fn setpoints_from_profiles_and_their_errors() {
     // drives the form as close as it goes, writes everything, and says so with status 3.
     assert_eq!(code, 3, "another customer: {stderr}");
     assert!(stderr.contains("could not take the shape") && stderr.contains("waist not reached"));
-    let form = concat!(env!("CARGO_MANIFEST_DIR"), "/sim/forms/reference.toml");
+    let form = concat!(env!("CARGO_MANIFEST_DIR"), "/sim/form-description/forms/reference.toml");
     let profiles = dir.join("profiles.json");
     let target = out.path().join("again.json");
     let (code, stdout, stderr) = common::dressform(&[

@@ -8,9 +8,9 @@ use dressform::mesh::Mesh;
 use dressform::pipeline::symmetrize;
 use dressform::profiles::Profiles;
 use dressform::scan::{self, frame::FrameOptions};
+use form_description::reference;
 use glam::DVec3;
 use sim::capture::{BodyParams, generate};
-use sim::form::reference;
 use std::path::Path;
 
 fn profiles_of(params: &BodyParams) -> Profiles {

@@ -6,9 +6,9 @@
 use dressform::mesh::Mesh;
 use dressform::scan::format::Format;
 use dressform::setpoints::SetPoints;
+use form_description::reference;
 use glam::DVec3;
 use sim::capture::{Artifacts, BodyParams, capture, generate};
-use sim::form::reference;
 use sim::serve::{ServeConfig, Transport, serve};
 
 fn scan_file(dir: &std::path::Path) -> std::path::PathBuf {

@@ -5,7 +5,7 @@ use std::process::{Command, Stdio};
 
 #[test]
 fn sim_prints_a_pseudo_terminal_that_exists() {
-    let form = concat!(env!("CARGO_MANIFEST_DIR"), "/sim/forms/reference.toml");
+    let form = concat!(env!("CARGO_MANIFEST_DIR"), "/sim/form-description/forms/reference.toml");
     for link in ["--serial-pty", "--slcan-pty"] {
         let mut child = Command::new(env!("CARGO_BIN_EXE_dressform"))
             .args(["sim", "--form", form, link])

@@ -1,4 +1,5 @@
-//! Actuators of a node, sets of them, and positions along their stroke.
+//! Actuators of a node, sets of them, positions along their stroke, and their speed and
+//! acceleration limits ([`Speed`] in 0.01 mm/s, [`Accel`] in 0.1 mm/s²).
 //!
 //! A node drives at most [`MAX_ACTUATORS`] (8) linear actuators, numbered 0..=7. A board with
 //! more actuators presents itself as several nodes (as ODrive does with its two axes).
@@ -131,9 +132,72 @@ impl Position {
         self.0
     }
 
-    /// The position in millimetres.
-    pub fn mm(self) -> f32 {
-        f32::from(self.0) / 100.0
+    /// The position in millimetres (exactly the nearest `f64` to the decimal value: the one
+    /// conversion from the wire's hundredths the host uses).
+    pub fn mm(self) -> f64 {
+        f64::from(self.0) / 100.0
+    }
+}
+
+/// A speed (limit), in the wire's unit of **0.01 mm/s**: 0..=655.35 mm/s.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Speed(u16);
+
+impl Speed {
+    /// The speed `hundredths_mm_s` × 0.01 mm/s.
+    pub const fn from_hundredths_mm_s(hundredths_mm_s: u16) -> Self {
+        Self(hundredths_mm_s)
+    }
+
+    /// The speed rounded to 0.01 mm/s, if `mm_s` is a number in 0..=655.35.
+    pub fn from_mm_s(mm_s: f64) -> Option<Self> {
+        let hundredths = (mm_s * 100.0).round();
+        // The negated comparison also rejects NaN.
+        if !(0.0..=f64::from(u16::MAX)).contains(&hundredths) {
+            return None;
+        }
+        Some(Self(hundredths as u16))
+    }
+
+    /// The speed in 0.01 mm/s (the wire value).
+    pub const fn hundredths_mm_s(self) -> u16 {
+        self.0
+    }
+
+    /// The speed in mm/s.
+    pub fn mm_s(self) -> f64 {
+        f64::from(self.0) / 100.0
+    }
+}
+
+/// An acceleration (limit, also for deceleration), in the wire's unit of **0.1 mm/s²**:
+/// 0..=6553.5 mm/s².
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Accel(u16);
+
+impl Accel {
+    /// The acceleration `tenths_mm_s2` × 0.1 mm/s².
+    pub const fn from_tenths_mm_s2(tenths_mm_s2: u16) -> Self {
+        Self(tenths_mm_s2)
+    }
+
+    /// The acceleration rounded to 0.1 mm/s², if `mm_s2` is a number in 0..=6553.5.
+    pub fn from_mm_s2(mm_s2: f64) -> Option<Self> {
+        let tenths = (mm_s2 * 10.0).round();
+        if !(0.0..=f64::from(u16::MAX)).contains(&tenths) {
+            return None;
+        }
+        Some(Self(tenths as u16))
+    }
+
+    /// The acceleration in 0.1 mm/s² (the wire value).
+    pub const fn tenths_mm_s2(self) -> u16 {
+        self.0
+    }
+
+    /// The acceleration in mm/s².
+    pub fn mm_s2(self) -> f64 {
+        f64::from(self.0) / 10.0
     }
 }
 
@@ -190,5 +254,17 @@ mod tests {
         assert_eq!(Position::new(0xFFFF), None);
         assert_eq!(position_from_wire(position_to_wire(None)), None);
         assert!((Position::new(2550).unwrap().mm() - 25.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn speeds_and_accelerations_carry_their_units() {
+        assert_eq!(Speed::from_mm_s(12.0).map(Speed::hundredths_mm_s), Some(1200));
+        assert_eq!(Speed::from_mm_s(655.35), Some(Speed::from_hundredths_mm_s(u16::MAX)));
+        assert_eq!(Speed::from_mm_s(655.36), None);
+        assert_eq!(Speed::from_mm_s(f64::NAN), None);
+        assert_eq!(Speed::from_hundredths_mm_s(1250).mm_s(), 12.5);
+        assert_eq!(Accel::from_mm_s2(50.0).map(Accel::tenths_mm_s2), Some(500));
+        assert_eq!(Accel::from_mm_s2(-0.1), None);
+        assert_eq!(Accel::from_tenths_mm_s2(505).mm_s2(), 50.5);
     }
 }

@@ -396,7 +396,8 @@ pub fn signal_values(message: &Message) -> heapless::Vec<i64, MAX_SIGNALS> {
         Message::Control(command) => push(&[*command as i64]),
         Message::Home(actuators) => push(&[actuators.bits().into()]),
         Message::MotionLimits(m) => {
-            push(&[m.actuators.bits().into(), m.max_speed.into(), m.max_accel.into()]);
+            let (speed, accel) = (m.max_speed.hundredths_mm_s(), m.max_accel.tenths_mm_s2());
+            push(&[m.actuators.bits().into(), speed.into(), accel.into()]);
         }
         Message::Identity(m) => push(&[
             m.protocol.major.into(),
@@ -407,7 +408,8 @@ pub fn signal_values(message: &Message) -> heapless::Vec<i64, MAX_SIGNALS> {
             m.actuator_count.into(),
         ]),
         Message::Capabilities(m) => {
-            push(&[m.stroke.hundredths_mm().into(), m.max_speed.into(), m.max_accel.into()]);
+            let (speed, accel) = (m.max_speed.hundredths_mm_s(), m.max_accel.tenths_mm_s2());
+            push(&[m.stroke.hundredths_mm().into(), speed.into(), accel.into()]);
         }
         Message::ParamRead(m) => push(&[m.param.0.into(), actuator_to_wire(m.actuator).into()]),
         Message::ParamWrite(m) | Message::ParamValue(m) => {

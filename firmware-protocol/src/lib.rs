@@ -7,7 +7,8 @@
 //!
 //! * [`can`]: classic CAN 2.0A (11-bit ids ordered by priority, ≤ 8-byte little-endian
 //!   payloads) with CAN FD for the two 16-byte messages; frames implement
-//!   [`embedded_can::Frame`]. [`dbc`] describes it for CAN tools.
+//!   [`embedded_can::Frame`]. [`dbc`] describes it for CAN tools; [`slcan`] is the text
+//!   of a classic frame on USB-CAN adapters.
 //! * [`serial`]: the same packets over a byte stream, with address, sequence number, CRC and
 //!   COBS framing, and a streaming [`serial::Decoder`].
 //!
@@ -48,11 +49,12 @@ pub mod message;
 pub mod param;
 pub mod payload;
 pub mod serial;
+pub mod slcan;
 pub mod timing;
 pub mod update;
 pub mod version;
 
-pub use actuator::{Actuator, ActuatorSet, Position};
+pub use actuator::{Accel, Actuator, ActuatorSet, Position, Speed};
 pub use error::Error;
 pub use message::{Address, Code, Message, NodeId, Packet};
 pub use version::{PROTOCOL_VERSION, ProtocolVersion};

@@ -12,7 +12,7 @@
 //! [`payload`](crate::payload).
 
 use crate::Error;
-use crate::actuator::{Actuator, ActuatorSet, MAX_ACTUATORS, Position};
+use crate::actuator::{Accel, Actuator, ActuatorSet, MAX_ACTUATORS, Position, Speed};
 use crate::drive::{AckStatus, DriveCommand, DriveState, EmergencyCode, Faults};
 use crate::param::ParamId;
 use crate::version::{FirmwareVersion, ProtocolVersion};
@@ -90,7 +90,8 @@ pub enum Addressing {
 }
 
 macro_rules! codes {
-    ($($(#[$doc:meta])* $name:ident = $value:literal, $dir:ident, $addr:ident, $len:literal;)*) => {
+    ($($(#[$doc:meta])* $name:ident = $value:literal, $dir:ident, $addr:ident, $len:literal,
+       [$($answer:ident),*];)*) => {
         /// The function code of a message (5 bits): its CAN priority class and its identity
         /// on every mapping. Codes 21..=30 are free for minor versions; 31 is never used (it
         /// would make CAN ids 0x7F0..=0x7FF, which old controllers reject).
@@ -139,53 +140,63 @@ macro_rules! codes {
                     $(Code::$name => stringify!($name),)*
                 }
             }
+
+            /// What a node sends back to a request with this code, in the order it sends
+            /// them (empty: nothing is answered). A request may also be refused with an
+            /// `Ack` naming its code ([`Message::answers`]).
+            pub const fn answers(self) -> &'static [Code] {
+                match self {
+                    $(Code::$name => &[$(Code::$answer),*],)*
+                }
+            }
         }
     };
 }
 
 codes! {
     /// Stop everything now (broadcast, highest priority).
-    EmergencyStop = 0, HostToNode, Broadcast, 0;
+    EmergencyStop = 0, HostToNode, Broadcast, 0, [];
     /// Start all staged moves, lasting a common duration.
-    Sync = 1, HostToNode, Broadcast, 2;
+    Sync = 1, HostToNode, Broadcast, 2, [];
     /// A fault or warning event.
-    Emergency = 2, NodeToHost, Node, 7;
+    Emergency = 2, NodeToHost, Node, 7, [];
     /// Staged targets of actuators 0..=3.
-    TargetsLower = 3, HostToNode, Node, 8;
+    TargetsLower = 3, HostToNode, Node, 8, [];
     /// Staged targets of actuators 4..=7.
-    TargetsUpper = 4, HostToNode, Node, 8;
+    TargetsUpper = 4, HostToNode, Node, 8, [];
     /// Staged targets of all eight actuators (CAN FD / serial).
-    AllTargets = 5, HostToNode, Node, 16;
+    AllTargets = 5, HostToNode, Node, 16, [];
     /// Actual positions of actuators 0..=3.
-    FeedbackLower = 6, NodeToHost, Node, 8;
+    FeedbackLower = 6, NodeToHost, Node, 8, [];
     /// Actual positions of actuators 4..=7.
-    FeedbackUpper = 7, NodeToHost, Node, 8;
+    FeedbackUpper = 7, NodeToHost, Node, 8, [];
     /// Actual positions of all eight actuators (CAN FD / serial).
-    AllFeedback = 8, NodeToHost, Node, 16;
-    /// The host is alive (feeds the node watchdogs; addressed, it polls one node).
-    HostHeartbeat = 9, HostToNode, NodeOrBroadcast, 2;
+    AllFeedback = 8, NodeToHost, Node, 16, [];
+    /// The host is alive (feeds the node watchdogs; addressed, it polls one node, which
+    /// answers with its heartbeat and positions).
+    HostHeartbeat = 9, HostToNode, NodeOrBroadcast, 2, [Heartbeat, AllFeedback];
     /// A node's state, faults and actuator status.
-    Heartbeat = 10, NodeToHost, Node, 6;
+    Heartbeat = 10, NodeToHost, Node, 6, [];
     /// A drive state machine command.
-    Control = 11, HostToNode, NodeOrBroadcast, 1;
+    Control = 11, HostToNode, NodeOrBroadcast, 1, [Ack];
     /// Home some actuators.
-    Home = 12, HostToNode, NodeOrBroadcast, 1;
+    Home = 12, HostToNode, NodeOrBroadcast, 1, [Ack];
     /// Speed and acceleration limits for some actuators.
-    MotionLimits = 13, HostToNode, NodeOrBroadcast, 5;
+    MotionLimits = 13, HostToNode, NodeOrBroadcast, 5, [Ack];
     /// Ask for `Identity` and `Capabilities`.
-    IdentifyRequest = 14, HostToNode, NodeOrBroadcast, 0;
+    IdentifyRequest = 14, HostToNode, NodeOrBroadcast, 0, [Identity, Capabilities];
     /// Protocol and firmware versions, actuator count.
-    Identity = 15, NodeToHost, Node, 6;
+    Identity = 15, NodeToHost, Node, 6, [];
     /// Stroke, speed and acceleration limits of the node's actuators.
-    Capabilities = 16, NodeToHost, Node, 6;
-    /// Read a parameter.
-    ParamRead = 17, HostToNode, Node, 3;
+    Capabilities = 16, NodeToHost, Node, 6, [];
+    /// Read a parameter (refused with an `Ack` naming it).
+    ParamRead = 17, HostToNode, Node, 3, [ParamValue];
     /// Write a parameter.
-    ParamWrite = 18, HostToNode, NodeOrBroadcast, 7;
+    ParamWrite = 18, HostToNode, NodeOrBroadcast, 7, [Ack];
     /// A parameter's value (answer to `ParamRead`).
-    ParamValue = 19, NodeToHost, Node, 7;
+    ParamValue = 19, NodeToHost, Node, 7, [];
     /// The outcome of a request.
-    Ack = 20, NodeToHost, Node, 2;
+    Ack = 20, NodeToHost, Node, 2, [];
 }
 
 /// One half of a node's actuators.
@@ -285,10 +296,10 @@ pub struct Heartbeat {
 pub struct MotionLimits {
     /// Which actuators.
     pub actuators: ActuatorSet,
-    /// Speed limit, 0.01 mm/s.
-    pub max_speed: u16,
-    /// Acceleration (and deceleration) limit, 0.1 mm/s².
-    pub max_accel: u16,
+    /// Speed limit.
+    pub max_speed: Speed,
+    /// Acceleration (and deceleration) limit.
+    pub max_accel: Accel,
 }
 
 /// `Identity`: who a node is.
@@ -308,10 +319,10 @@ pub struct Identity {
 pub struct Capabilities {
     /// Stroke: targets lie in 0..=stroke.
     pub stroke: Position,
-    /// Highest speed, 0.01 mm/s.
-    pub max_speed: u16,
-    /// Highest acceleration, 0.1 mm/s².
-    pub max_accel: u16,
+    /// Highest speed.
+    pub max_speed: Speed,
+    /// Highest acceleration.
+    pub max_accel: Accel,
 }
 
 /// `ParamRead`: ask for a parameter.
@@ -377,7 +388,7 @@ pub enum Message {
     Identity(Identity),
     /// What a node's actuators can do.
     Capabilities(Capabilities),
-    /// Read a parameter. Answered by `ParamValue`, or `Ack` on failure.
+    /// Read a parameter (refused with an `Ack` naming it). Answered by `ParamValue`, or `Ack` on failure.
     ParamRead(ParamRead),
     /// Write a parameter. Answered by `Ack`.
     ParamWrite(Param),
@@ -412,6 +423,17 @@ impl Message {
             Self::ParamWrite(_) => Code::ParamWrite,
             Self::ParamValue(_) => Code::ParamValue,
             Self::Ack(_) => Code::Ack,
+        }
+    }
+
+    /// Whether this message (from a node) answers `request`: its code is one of the
+    /// request's [`Code::answers`], or it is an `Ack` naming the request's code (an answer
+    /// or a refusal).
+    pub fn answers(&self, request: &Message) -> bool {
+        let request = request.code();
+        match self {
+            Self::Ack(ack) => ack.request == request,
+            reply => request.answers().contains(&reply.code()),
         }
     }
 }
@@ -451,6 +473,22 @@ impl Packet {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn requests_name_their_answers_and_answers_flow_back() {
+        for code in Code::ALL {
+            for &answer in code.answers() {
+                assert_eq!(code.direction(), Direction::HostToNode, "{}", code.name());
+                assert_eq!(answer.direction(), Direction::NodeToHost, "{}", answer.name());
+            }
+        }
+        let enable = Message::Control(crate::drive::DriveCommand::Enable);
+        let ok = |request| Message::Ack(Ack { request, status: crate::drive::AckStatus::Ok });
+        assert!(ok(Code::Control).answers(&enable));
+        assert!(!ok(Code::Home).answers(&enable));
+        assert_eq!(Code::IdentifyRequest.answers(), [Code::Identity, Code::Capabilities]);
+        assert!(!Message::EmergencyStop.answers(&Message::IdentifyRequest));
+    }
 
     #[test]
     fn codes_are_dense_and_below_31() {

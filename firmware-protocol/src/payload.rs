@@ -32,7 +32,7 @@
 
 use crate::Error;
 use crate::actuator::{
-    ActuatorSet, Position, actuator_from_wire, actuator_to_wire, position_from_wire,
+    Accel, ActuatorSet, Position, Speed, actuator_from_wire, actuator_to_wire, position_from_wire,
     position_to_wire,
 };
 use crate::drive::{AckStatus, DriveCommand, DriveState, EmergencyCode, Faults};
@@ -112,8 +112,8 @@ pub fn encode(message: &Message) -> Payload {
         Message::Home(actuators) => out.u8(actuators.bits()),
         Message::MotionLimits(m) => {
             out.u8(m.actuators.bits());
-            out.u16(m.max_speed);
-            out.u16(m.max_accel);
+            out.u16(m.max_speed.hundredths_mm_s());
+            out.u16(m.max_accel.tenths_mm_s2());
         }
         Message::Identity(m) => {
             out.put(&[m.protocol.major, m.protocol.minor]);
@@ -122,8 +122,8 @@ pub fn encode(message: &Message) -> Payload {
         }
         Message::Capabilities(m) => {
             out.u16(m.stroke.hundredths_mm());
-            out.u16(m.max_speed);
-            out.u16(m.max_accel);
+            out.u16(m.max_speed.hundredths_mm_s());
+            out.u16(m.max_accel.tenths_mm_s2());
         }
         Message::ParamRead(m) => {
             out.u16(m.param.0);
@@ -223,8 +223,8 @@ pub fn decode(code: Code, payload: &[u8]) -> Result<Message, Error> {
         Code::Home => Message::Home(r.set()?),
         Code::MotionLimits => Message::MotionLimits(MotionLimits {
             actuators: r.set()?,
-            max_speed: r.u16()?,
-            max_accel: r.u16()?,
+            max_speed: Speed::from_hundredths_mm_s(r.u16()?),
+            max_accel: Accel::from_tenths_mm_s2(r.u16()?),
         }),
         Code::IdentifyRequest => Message::IdentifyRequest,
         Code::Identity => Message::Identity(Identity {
@@ -240,8 +240,8 @@ pub fn decode(code: Code, payload: &[u8]) -> Result<Message, Error> {
         }),
         Code::Capabilities => Message::Capabilities(Capabilities {
             stroke: position_from_wire(r.u16()?).ok_or(Error::InvalidField("stroke"))?,
-            max_speed: r.u16()?,
-            max_accel: r.u16()?,
+            max_speed: Speed::from_hundredths_mm_s(r.u16()?),
+            max_accel: Accel::from_tenths_mm_s2(r.u16()?),
         }),
         Code::ParamRead => {
             Message::ParamRead(ParamRead { param: ParamId(r.u16()?), actuator: r.actuator()? })

@@ -15,7 +15,7 @@
 //! the distance and the actuator's limits; host and node use this one formula.
 
 use crate::Link;
-use crate::actuator::{MAX_ACTUATORS, Position};
+use crate::actuator::{Accel, MAX_ACTUATORS, Position, Speed};
 use crate::message::{Half, Message, NodeId, Packet, Positions8, Sync};
 
 /// The targets of one node in a form update (`None`: leave that actuator where it is).
@@ -51,10 +51,11 @@ pub fn packets(nodes: &[NodeTargets], sync: Sync, link: Link) -> impl Iterator<I
     staged.chain([Packet::broadcast(Message::Sync(sync))])
 }
 
-/// The shortest move (ms, rounded up) over `distance` (0.01 mm) within `max_speed`
-/// (0.01 mm/s) and `max_accel` (0.1 mm/s²): a triangular or trapezoidal velocity profile
-/// starting and ending at rest. `None` if a limit is zero and the distance is not.
-pub fn shortest_duration_ms(distance: u16, max_speed: u16, max_accel: u16) -> Option<u32> {
+/// The shortest move (ms, rounded up) over `distance` (0.01 mm) within `max_speed` and
+/// `max_accel`: a triangular or trapezoidal velocity profile starting and ending at rest.
+/// `None` if a limit is zero and the distance is not.
+pub fn shortest_duration_ms(distance: u16, max_speed: Speed, max_accel: Accel) -> Option<u32> {
+    let (max_speed, max_accel) = (max_speed.hundredths_mm_s(), max_accel.tenths_mm_s2());
     if distance == 0 {
         return Some(0);
     }
@@ -79,18 +80,27 @@ pub fn shortest_duration_ms(distance: u16, max_speed: u16, max_accel: u16) -> Op
 mod tests {
     use super::*;
 
+    /// [`shortest_duration_ms`] with the limits in their wire units.
+    fn duration(distance: u16, speed: u16, accel: u16) -> Option<u32> {
+        shortest_duration_ms(
+            distance,
+            Speed::from_hundredths_mm_s(speed),
+            Accel::from_tenths_mm_s2(accel),
+        )
+    }
+
     #[test]
     fn a_move_that_reaches_max_speed_is_a_trapezoid() {
         // 50 mm at 10 mm/s with 100 mm/s²: ramps of 0.1 s (0.5 mm each), 4.9 s cruise.
-        assert_eq!(shortest_duration_ms(5000, 1000, 1000), Some(5100));
+        assert_eq!(duration(5000, 1000, 1000), Some(5100));
     }
 
     #[test]
     fn a_short_move_is_a_triangle() {
         // 1 mm with 100 mm/s²: 2·√(0.01) s = 200 ms, peak 10 mm/s (= max_speed, the boundary).
-        assert_eq!(shortest_duration_ms(100, 1000, 1000), Some(200));
+        assert_eq!(duration(100, 1000, 1000), Some(200));
         // 0.25 mm: 2·√(0.0025) = 100 ms.
-        assert_eq!(shortest_duration_ms(25, 1000, 1000), Some(100));
+        assert_eq!(duration(25, 1000, 1000), Some(100));
     }
 
     proptest::proptest! {
@@ -100,16 +110,16 @@ mod tests {
         ) {
             let (d, v, a) = (distance as f64 / 100.0, max_speed as f64 / 100.0, max_accel as f64 / 10.0);
             let exact_s = if d * a <= v * v { 2.0 * (d / a).sqrt() } else { d / v + v / a };
-            let ms = shortest_duration_ms(distance, max_speed, max_accel).unwrap() as f64;
+            let ms = duration(distance, max_speed, max_accel).unwrap() as f64;
             proptest::prop_assert!(ms >= exact_s * 1000.0 - 1e-6 && ms < exact_s * 1000.0 + 2.0);
         }
     }
 
     #[test]
     fn zero_limits_make_any_move_infeasible() {
-        assert_eq!(shortest_duration_ms(0, 0, 0), Some(0));
-        assert_eq!(shortest_duration_ms(1, 0, 10), None);
-        assert_eq!(shortest_duration_ms(1, 10, 0), None);
+        assert_eq!(duration(0, 0, 0), Some(0));
+        assert_eq!(duration(1, 0, 10), None);
+        assert_eq!(duration(1, 10, 0), None);
     }
 
     #[test]

@@ -22,23 +22,12 @@ use serde_json::{Value, json};
 const CASES: usize = 4000;
 
 fn cantools_available() -> bool {
-    let probe = Command::new("python3").args(["-c", "import cantools"]).output();
-    match probe {
-        Ok(out) if out.status.success() => true,
-        result => {
-            let why = match result {
-                Ok(out) => String::from_utf8_lossy(&out.stderr).trim().to_string(),
-                Err(e) => format!("python3: {e}"),
-            };
-            let required = std::env::var("DRESSFORM_REQUIRE_PEERS").is_ok_and(|v| v == "1");
-            assert!(!required, "DRESSFORM_REQUIRE_PEERS=1 but cantools is unavailable: {why}");
-            eprintln!(
-                "SKIPPED: cantools cross-check, cantools is unavailable ({why}); \
-                 install it with `python3 -m pip install cantools`"
-            );
-            false
-        }
-    }
+    crate::skip::or_skip(
+        crate::skip::python_modules("cantools"),
+        "cantools (`python3 -m pip install cantools`)",
+        "DRESSFORM_REQUIRE_PEERS",
+    )
+    .is_some()
 }
 
 /// Deterministic packets for the DBC's nodes 1..=8.

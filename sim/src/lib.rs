@@ -1,8 +1,9 @@
 //! Simulations that stand in for hardware in tests, CI and the demo.
 //!
+//! Two jobs that share nothing (`tests/scripts/module_dag.py` checks that neither imports the
+//! other): synthetic customers, and the form simulator.
+//!
 //! - [`capture`]: synthetic body scans with known ground truth, and scanner artifacts.
-//! - [`form`]: robotic form descriptions (nodes, rings, actuators, mirror pairs) and the
-//!   shipped reference form.
 //! - [`node`]: the simulated node, the node side of `firmware-protocol` as a pure state
 //!   machine.
 //! - [`fault`]: fault injection per run (bus, node, actuator) from one spec string.
@@ -15,7 +16,6 @@
 pub mod bus;
 pub mod capture;
 pub mod fault;
-pub mod form;
 pub mod node;
 pub mod robot;
 pub mod serve;

@@ -12,7 +12,7 @@
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! use sim::serve::{ServeConfig, Transport};
 //!
-//! let mut config = ServeConfig::new(sim::form::reference(), Transport::SlcanPty);
+//! let mut config = ServeConfig::new(form_description::reference(), Transport::SlcanPty);
 //! config.log = Some("traffic.log".into());
 //! config.faults = "drop=0.01".parse()?;
 //! sim::serve::run_until_ctrl_c(config, |device| println!("{}", device.display()))?;
@@ -44,8 +44,8 @@ use crate::bus::pty::{Canary, Pty};
 use crate::bus::serial::{DEFAULT_BAUD, SerialLine};
 use crate::bus::slcan::SlcanAdapter;
 use crate::fault::FaultSpec;
-use crate::form::{FormDescription, FormError};
 use crate::robot::{SimError, SimOptions, SimulatedForm};
+use form_description::FormDescription;
 
 /// How the host connects.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -145,11 +145,7 @@ fn joined(thread: JoinHandle<Result<(), ServeError>>) -> Result<(), ServeError> 
 /// Callable from anywhere (within a tokio runtime or not); the form runs until the
 /// [`Server`] is stopped or dropped.
 pub fn serve(config: ServeConfig) -> Result<Server, ServeError> {
-    // Refuse a bad form or fault spec before creating anything.
-    config
-        .form
-        .validate()
-        .map_err(|problems| SimError::from(FormError::Invalid { path: None, problems }))?;
+    // Refuse a bad fault spec before creating anything (the form is valid by its type).
     config.faults.check(&config.form).map_err(SimError::from)?;
     let (ready, started) = std::sync::mpsc::channel();
     let (stop, stopped) = oneshot::channel();

@@ -3,7 +3,7 @@
 
 use std::collections::HashSet;
 
-use sim::form::{FormDescription, FormError, REFERENCE_TOML, reference};
+use form_description::{FormDescription, FormError, REFERENCE_TOML, reference};
 
 #[test]
 fn the_reference_form_is_64_mirror_symmetric_actuators_on_8_nodes() {
@@ -141,14 +141,43 @@ fn validation_names_every_problem() {
 
 #[test]
 fn a_channel_gap_and_an_off_centre_ring_without_mirror_are_refused() {
-    use sim::form::Problem;
-    let mut form = reference();
+    use form_description::Problem;
+    let mut form = reference().into_spec();
     form.actuators.retain(|a| a.id != "neck-l1" && a.id != "neck-r1");
-    let problems = form.validate().unwrap_err();
+    let problems = FormDescription::try_from(form).unwrap_err();
     assert_eq!(problems, [Problem::ChannelGap { address: 1, channels: vec![0, 2, 4, 5, 6, 7] }]);
     assert!(problems[0].to_string().contains("must be numbered 0..6 without gaps"));
     let message = error(&edited("mirror = \"thigh-r\"\n", ""));
     assert!(message.contains("ring `thigh-l`: is off the centre line"), "{message}");
+}
+
+#[test]
+fn ring_roles_are_stated_and_checked() {
+    let form = reference();
+    let anchors: Vec<(&str, &str)> =
+        form.rings.iter().filter_map(|r| r.anchor.map(|a| (r.name.as_str(), a.name()))).collect();
+    assert_eq!(anchors, [("neck", "neck"), ("chest", "chest"), ("waist", "waist"), ("hip", "hip")]);
+    let parts: Vec<&str> = form.rings.iter().map(|r| r.part.name()).collect();
+    assert_eq!(parts[..7], ["torso"; 7]);
+    assert_eq!(parts[7..], ["left-leg", "right-leg"]);
+    let cases: [(&str, &str, &str); 4] = [
+        (
+            "part = \"left-leg\"\n",
+            "",
+            "ring `thigh-l`: `part` the ring is off the body axis (x = 105 mm)",
+        ),
+        ("part = \"left-leg\"", "part = \"right-leg\"", "\"right-leg\" needs its centre"),
+        (
+            "anchor = \"waist\"",
+            "anchor = \"chest\"",
+            "\"chest\" is already the anchor of ring `chest`",
+        ),
+        ("anchor = \"neck\"", "anchor = \"elbow\"", "unknown variant `elbow`"),
+    ];
+    for (from, to, expected) in cases {
+        let message = error(&edited(from, to));
+        assert!(message.contains(expected), "{from} -> {to}:\n{message}\nexpected: {expected}");
+    }
 }
 
 #[test]

@@ -11,9 +11,9 @@ use firmware_protocol::message::{Emergency, Sync};
 use firmware_protocol::timing::FEEDBACK_PERIOD_MS;
 use firmware_protocol::update::{self, NodeTargets};
 use firmware_protocol::{Actuator, Address, Link, Message, NodeId, Packet, Position};
+use form_description::{FormDescription, reference};
 use sim::bus::can::{CanBus, CanKind};
 use sim::fault::FaultSpec;
-use sim::form::{FormDescription, reference};
 use sim::robot::{SimOptions, SimulatedForm};
 use test_host::{TestHost, host_heartbeat};
 use tokio::time::{Duration, Instant};
@@ -112,7 +112,7 @@ fn arrivals(
             };
             let still = moving.get(&n).is_some_and(|m| m & (1 << index) == 0);
             let on_target =
-                slot.is_some_and(|p| (f64::from(p.mm()) - targets[&spec.id]).abs() <= TOLERANCE_MM);
+                slot.is_some_and(|p| (p.mm() - targets[&spec.id]).abs() <= TOLERANCE_MM);
             if still && on_target {
                 arrived.entry(spec.id.clone()).or_insert(*at);
             }

@@ -3,6 +3,8 @@
 
 #[path = "support/section.rs"]
 mod section;
+#[path = "../../tests/common/skip.rs"]
+mod skip;
 mod test_host;
 #[path = "support/topology.rs"]
 mod topology;

@@ -10,8 +10,8 @@ use firmware_protocol::param::ParamId;
 use firmware_protocol::update::shortest_duration_ms;
 use firmware_protocol::version::FirmwareVersion;
 use firmware_protocol::{
-    Actuator, ActuatorSet, Code, Link, Message, NodeId, PROTOCOL_VERSION, Packet, Position,
-    ProtocolVersion,
+    Accel, Actuator, ActuatorSet, Code, Link, Message, NodeId, PROTOCOL_VERSION, Packet, Position,
+    ProtocolVersion, Speed,
 };
 use sim::node::{ActuatorConfig, ActuatorFault, Node, NodeConfig};
 use tokio::time::{Duration, Instant};
@@ -200,7 +200,8 @@ fn on_serial_broadcasts_are_obeyed_but_never_answered() {
         panic!("{identity:?}")
     };
     assert_eq!((id.protocol, id.actuator_count, id.firmware.patch), (PROTOCOL_VERSION, 8, 4));
-    assert_eq!((c.stroke.hundredths_mm(), c.max_speed, c.max_accel), (5000, 1000, 500));
+    let limits = (c.max_speed.hundredths_mm_s(), c.max_accel.tenths_mm_s2());
+    assert_eq!((c.stroke.hundredths_mm(), limits), (5000, (1000, 500)));
     // Other nodes' packets and node → host messages are ignored.
     assert!(bench.send(Packet::node(NodeId::new(2).unwrap(), Message::IdentifyRequest)).is_empty());
     assert!(
@@ -257,7 +258,8 @@ fn a_sync_too_short_moves_at_the_limits_and_reports_the_shortest_duration() {
     bench.send(to_node(Message::Targets(all.half(Half::Lower))));
     let start = bench.now;
     let sent = bench.send(Packet::broadcast(Message::Sync(Sync { duration_ms: 1000 })));
-    let shortest = shortest_duration_ms(4000, 1000, 500).unwrap();
+    let limits = (Speed::from_hundredths_mm_s(1000), Accel::from_tenths_mm_s2(500));
+    let shortest = shortest_duration_ms(4000, limits.0, limits.1).unwrap();
     assert_eq!(
         events(&sent),
         [Emergency {
@@ -331,8 +333,8 @@ fn parameters_have_the_readme_scopes_and_ranges() {
     let limits = |max_speed, max_accel| {
         to_node(Message::MotionLimits(MotionLimits {
             actuators: ActuatorSet::ALL,
-            max_speed,
-            max_accel,
+            max_speed: Speed::from_hundredths_mm_s(max_speed),
+            max_accel: Accel::from_tenths_mm_s2(max_accel),
         }))
     };
     assert_eq!(bench.send(limits(1000, 501)), [ack(Code::MotionLimits, InvalidArgument)]);

@@ -11,8 +11,8 @@ use firmware_protocol::message::{Ack, HostHeartbeat, Positions8, Sync};
 use firmware_protocol::{
     ActuatorSet, Address, Code, Message, NodeId, PROTOCOL_VERSION, Packet, Position, serial,
 };
+use form_description::reference;
 use serialport::SerialPort;
-use sim::form::reference;
 use sim::serve::{ServeConfig, Transport, serve};
 
 /// A blocking serial host.

@@ -8,8 +8,8 @@ use std::time::{Duration, Instant};
 use embedded_can::{Frame as _, StandardId};
 use firmware_protocol::can::Frame;
 use firmware_protocol::{Code, Message, can};
+use form_description::reference;
 use serialport::SerialPort;
-use sim::form::reference;
 use sim::serve::{ServeConfig, Server, Transport, serve};
 
 /// The reference form behind an slcan adapter.

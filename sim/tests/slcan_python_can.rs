@@ -9,27 +9,16 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use sim::form::reference;
+use form_description::reference;
 use sim::serve::{ServeConfig, Transport, serve};
 
 fn python_can_available() -> bool {
-    let probe = Command::new("python3").args(["-c", "import can, serial"]).output();
-    match probe {
-        Ok(out) if out.status.success() => true,
-        result => {
-            let why = match result {
-                Ok(out) => String::from_utf8_lossy(&out.stderr).trim().to_string(),
-                Err(e) => format!("python3: {e}"),
-            };
-            let required = std::env::var("DRESSFORM_REQUIRE_PEERS").is_ok_and(|v| v == "1");
-            assert!(!required, "DRESSFORM_REQUIRE_PEERS=1 but python-can is unavailable: {why}");
-            eprintln!(
-                "SKIPPED: python-can peer, python-can or pyserial is unavailable ({why}); \
-                 install them with `python3 -m pip install python-can pyserial`"
-            );
-            false
-        }
-    }
+    crate::skip::or_skip(
+        crate::skip::python_modules("can, serial"),
+        "python-can or pyserial (`python3 -m pip install python-can pyserial`)",
+        "DRESSFORM_REQUIRE_PEERS",
+    )
+    .is_some()
 }
 
 fn peer(args: &[&str]) -> Output {

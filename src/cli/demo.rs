@@ -78,7 +78,8 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         options: &DriveOptions::default(),
         girth_tolerance: DEFAULT_GIRTH_TOLERANCE_MM,
     };
-    let (result, shape) = shape_form(&scan, &sim::form::reference(), &drive, &args.out, outputs)?;
+    let (result, shape) =
+        shape_form(&scan, &form_description::reference(), &drive, &args.out, outputs)?;
     outln!();
     outln!("  {:<12} {:>9} {:>9} {:>11}", "measure (mm)", "customer", "scan", "mannequin");
     let c = &result.comparison;

@@ -14,7 +14,7 @@ use dressform::controller::{
 };
 use dressform::fitting::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
 use dressform::setpoints::SetPoints;
-use sim::form::FormDescription;
+use form_description::FormDescription;
 
 use super::Failure;
 use super::link::{self, FormArg, LinkArgs, runtime};

@@ -53,8 +53,8 @@ fn on_sim(args: &EstopArgs) -> Result<(), Failure> {
         let rig = link::simulated(&form, &SimConfig::default())?;
         emergency_stop(&rig.attach()).map_err(Failure::other)?;
         let deadline = tokio::time::Instant::now() + SETTLE;
-        let latched = |t: &sim::robot::FormState| t.nodes.iter().all(|n| !n.faults.is_empty());
-        while !latched(&rig.truth()) && tokio::time::Instant::now() < deadline {
+        let latched = || rig.truth().nodes.iter().all(|n| !n.faults.is_empty());
+        while !latched() && tokio::time::Instant::now() < deadline {
             tokio::time::sleep(Duration::from_millis(1)).await;
         }
         Ok::<_, Failure>(rig.truth())

@@ -5,7 +5,7 @@
 use super::Failure;
 use super::link::FormArg;
 use dressform::fitting::ring_girth;
-use sim::form::{FormDescription, REFERENCE_TOML};
+use form_description::{FormDescription, REFERENCE_TOML};
 use std::collections::BTreeMap;
 
 #[derive(Debug, clap::Args)]

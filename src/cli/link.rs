@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use dressform::controller::control::Endpoint;
 use dressform::controller::simulated::{SimConfig, SimDriveError, SimulatedRig};
 use dressform::controller::{Connection, LinkSpec, Transport};
-use sim::form::FormDescription;
+use form_description::FormDescription;
 
 use super::Failure;
 use super::signals::{self, Armed};
@@ -55,7 +55,7 @@ impl FormArg {
     pub fn load(&self) -> Result<FormDescription, Failure> {
         match &self.form {
             Some(path) => FormDescription::load(path).map_err(Failure::bad_input),
-            None => Ok(sim::form::reference()),
+            None => Ok(form_description::reference()),
         }
     }
 

@@ -19,7 +19,7 @@ use dressform::profiles::Profiles;
 use dressform::regions::Region;
 use dressform::scan::{self, Scan, format::Export, format::Format};
 use dressform::setpoints::SetPoints;
-use sim::form::FormDescription;
+use form_description::FormDescription;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

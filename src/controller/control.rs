@@ -23,8 +23,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
-use super::estop::{Gate, StopCause};
 use super::transport::LinkSpec;
+use super::transport::{Gate, StopCause};
 
 /// How long either side waits for the other's line (the owner answers once three frames are
 /// written, a few milliseconds).

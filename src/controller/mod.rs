@@ -2,19 +2,17 @@
 //! simulated bus.
 //!
 //! [`drive`] runs one shape change: check the set-points against the form description
-//! (nothing outside a stroke, see [`safety`]), discover every node and check it against the
+//! (nothing outside a stroke, see [`crate::safety`]), discover every node and check it against the
 //! description ([`session`]), enable and home, one synchronised move with live progress and
 //! per-actuator report ([`motion`]), then disable (the drives hold the panels).
 //!
 //! | module | what it holds |
 //! |---|---|
-//! | [`transport`] | the [`Transport`] trait; serial, slcan, SocketCAN and simulated links |
-//! | [`estop`] | the [`Gate`] every packet goes through, and the e-stop on it from any thread |
+//! | [`transport`] | the [`Transport`] trait; serial, slcan, SocketCAN and simulated links; the [`Gate`] every packet goes through, and the e-stop on it from any thread (`transport::gate`) |
 //! | [`control`] | the local control endpoint: `dressform estop` reaching the link's owner |
 //! | [`session`] | discovery, fault reset, enable/home, heartbeats and polls, liveness, faults, reboots |
 //! | [`motion`] | staging, the common SYNC duration, watching feedback, the report |
 //! | [`faults`] | states, faults, events and refusals in words; which faults the host clears |
-//! | [`safety`] | [`SafeTarget`]: the only way a target reaches the wire |
 //! | [`simulated`] | the whole thing on the in-process simulated form |
 //!
 //! Safety rules, all enforced here: targets come only from [`SafeTarget`]s built against the
@@ -26,10 +24,8 @@
 //! cleared without the caller's say-so.
 
 pub mod control;
-pub mod estop;
 pub mod faults;
 pub mod motion;
-pub mod safety;
 pub mod session;
 pub mod simulated;
 pub mod transport;
@@ -39,16 +35,15 @@ use std::time::Duration;
 
 use firmware_protocol::NodeId;
 use firmware_protocol::drive::Faults;
+use form_description::FormDescription;
 use serde::Serialize;
-use sim::form::FormDescription;
 use tokio::time::Instant;
 
-pub use estop::{Gate, StopCause};
+pub use crate::safety::SafeTarget;
 pub use faults::{fault_names, state_name};
 pub use motion::{ActuatorReport, MoveError, NodeProgress, PlannedTarget, Progress};
-pub use safety::SafeTarget;
 pub use session::{Cleared, NodeProblem, Session, SessionError};
-pub use transport::{Connection, LinkSpec, Transport, TransportError};
+pub use transport::{Connection, Gate, LinkSpec, StopCause, Transport, TransportError};
 
 use crate::setpoints::{OutOfStroke, SetPoints};
 
@@ -250,7 +245,7 @@ fn positions_of<T: Transport>(session: &Session<T>) -> BTreeMap<String, f64> {
         .iter()
         .filter_map(|a| {
             let p = session.nodes().get(&a.node_id()?)?.positions[a.actuator()?.index()]?;
-            Some((a.id.clone(), f64::from(p.hundredths_mm()) / 100.0))
+            Some((a.id.clone(), p.mm()))
         })
         .collect()
 }
@@ -317,7 +312,7 @@ pub async fn status<T: Transport>(
                     .iter()
                     .map(|a| {
                         let p = a.actuator().and_then(|i| status.positions[i.index()]);
-                        (a.id.clone(), p.map(|p| f64::from(p.hundredths_mm()) / 100.0))
+                        (a.id.clone(), p.map(|p| p.mm()))
                     })
                     .collect(),
                 problems: problems.iter().map(ToString::to_string).collect(),
@@ -352,7 +347,7 @@ pub async fn reset<T: Transport>(
     Ok(ResetReport { problems, cleared })
 }
 
-/// Broadcasts an emergency stop on a link this process opened (see [`estop::Gate`]): every
+/// Broadcasts an emergency stop on a link this process opened (see [`Gate`]): every
 /// node stops, powers off and latches `EMERGENCY_STOP` until a FaultReset.
 pub fn emergency_stop<T: Transport>(transport: &T) -> Result<(), TransportError> {
     transport.gate().emergency_stop(StopCause::Requested)

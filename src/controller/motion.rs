@@ -21,13 +21,13 @@ use std::time::Duration;
 use firmware_protocol::actuator::MAX_ACTUATORS;
 use firmware_protocol::message::Sync;
 use firmware_protocol::update::{NodeTargets, packets, shortest_duration_ms};
-use firmware_protocol::{Actuator, Message, NodeId, Packet};
+use firmware_protocol::{Accel, Actuator, Message, NodeId, Packet, Speed};
 use serde::Serialize;
 use tokio::time::Instant;
 
-use super::safety::SafeTarget;
 use super::session::{Session, SessionError};
 use super::transport::Transport;
+use crate::safety::SafeTarget;
 
 /// How many times a move resumes after node reboots before it fails.
 pub const MAX_RESUMES: usize = 2;
@@ -43,10 +43,10 @@ pub struct PlannedTarget {
     pub actuator: Actuator,
     /// Where it goes.
     pub target: SafeTarget,
-    /// Speed limit, 0.01 mm/s.
-    pub max_speed: u16,
-    /// Acceleration limit, 0.1 mm/s².
-    pub max_accel: u16,
+    /// Speed limit.
+    pub max_speed: Speed,
+    /// Acceleration limit.
+    pub max_accel: Accel,
     /// Stroke, 0.01 mm (the distance assumed when the position is unknown).
     pub stroke: u16,
 }
@@ -296,10 +296,11 @@ async fn sync<T: Transport>(
 
 /// How many times targets and SYNC are resent when heartbeats do not confirm them.
 const CONFIRM_RETRIES: usize = 3;
-/// How long to wait for heartbeats confirming targets or SYNC: two of the nodes' heartbeat
-/// periods (100 ms each, [`firmware_protocol::timing::HEARTBEAT_PERIOD_MS`]) and half of one more for a busy
-/// host.
-const CONFIRM_TIMEOUT: Duration = Duration::from_millis(250);
+/// How long to wait for heartbeats confirming targets or SYNC: two and a half of the nodes'
+/// heartbeat periods ([`firmware_protocol::timing::HEARTBEAT_PERIOD_MS`], 100 ms: 250 ms),
+/// two heartbeats and half of one more for a busy host.
+const CONFIRM_TIMEOUT: Duration =
+    Duration::from_millis(firmware_protocol::timing::HEARTBEAT_PERIOD_MS as u64 * 5 / 2);
 
 /// Whether a heartbeat of `n`'s node received after `since` shows its targets staged
 /// (`None`: no such heartbeat yet).
@@ -317,7 +318,7 @@ fn staged<T: Transport>(session: &Session<T>, n: &NodeTargets, since: Instant) -
 
 fn position_mm<T: Transport>(session: &Session<T>, t: &PlannedTarget) -> Option<f64> {
     let p = session.nodes().get(&t.node)?.positions[t.actuator.index()]?;
-    Some(f64::from(p.hundredths_mm()) / 100.0)
+    Some(p.mm())
 }
 
 fn within<T: Transport>(session: &Session<T>, t: &PlannedTarget, tolerance_mm: f64) -> bool {

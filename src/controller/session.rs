@@ -34,8 +34,8 @@
 //! [`super::faults`]).
 //!
 //! Safety: the session never sends targets itself; `motion` builds them from
-//! [`SafeTarget`](super::safety::SafeTarget)s only. Every packet goes through the link's
-//! [`Gate`](super::estop::Gate): once the link is e-stopped, from any thread, nothing else is
+//! [`SafeTarget`](crate::safety::SafeTarget)s only. Every packet goes through the link's
+//! [`Gate`](super::transport::Gate): once the link is e-stopped, from any thread, nothing else is
 //! sent and the session ends with [`SessionError::Stopped`]. Every way out of a failed move
 //! goes through a broadcast `Halt` or `EmergencyStop`.
 
@@ -44,18 +44,19 @@ use std::time::Duration;
 
 use firmware_protocol::actuator::MAX_ACTUATORS;
 use firmware_protocol::drive::{AckStatus, DriveCommand, DriveState, EmergencyCode, Faults};
-use firmware_protocol::message::{Capabilities, Emergency, Heartbeat, HostHeartbeat, Identity};
+use firmware_protocol::message::{
+    Capabilities, Emergency, Heartbeat, HostHeartbeat, Identity, Positions8,
+};
 use firmware_protocol::version::Compatibility;
 use firmware_protocol::{
-    ActuatorSet, Address, Code, Link, Message, NodeId, PROTOCOL_VERSION, Packet, Position, timing,
+    ActuatorSet, Address, Link, Message, NodeId, PROTOCOL_VERSION, Packet, Position, timing,
 };
-use sim::form::FormDescription;
+use form_description::FormDescription;
 use tokio::sync::watch;
 use tokio::time::{Instant, sleep_until};
 
-use super::estop::StopCause;
 use super::faults::{self, Fault, NodeName};
-use super::transport::{Transport, TransportError};
+use super::transport::{StopCause, Transport, TransportError};
 
 /// The host heartbeat period on CAN.
 pub const HEARTBEAT_PERIOD: Duration =
@@ -69,7 +70,7 @@ pub const NODE_LOST_AFTER: Duration = Duration::from_millis(timing::NODE_LOST_AF
 pub const POLLS_LOST: u32 = (timing::NODE_LOST_AFTER_MS / timing::HEARTBEAT_PERIOD_MS) as u32;
 /// How long the whole link may carry nothing before its silence is blamed on the nodes (CAN)
 /// or requests time out regardless: the longest stall of a pseudo-terminal measured on a
-/// loaded 2-core machine (1.3 s, the kernel holding every pty's bytes; see `sim::bus::pty`),
+/// loaded 2-core machine (1.3 s, the kernel holding every pty's bytes; see the simulator's `bus/pty.rs`),
 /// with margin. A single silent node is still found within [`NODE_LOST_AFTER`], since the
 /// others keep talking.
 pub const LINK_STALL_LIMIT: Duration = Duration::from_secs(2);
@@ -290,6 +291,17 @@ pub const ATTEMPTS: u8 = timing::RETRIES + 3;
 /// again.
 const REENABLES: usize = 2;
 
+/// A request's name for people: a drive command's own name (`Enable`), else its code's.
+fn request_name(request: &Message) -> &'static str {
+    match request {
+        Message::Control(DriveCommand::Disable) => "Disable",
+        Message::Control(DriveCommand::Enable) => "Enable",
+        Message::Control(DriveCommand::FaultReset) => "FaultReset",
+        Message::Control(DriveCommand::Halt) => "Halt",
+        other => other.code().name(),
+    }
+}
+
 /// How long to wait for an answer before retrying.
 fn answer_timeout(link: Link) -> Duration {
     match link {
@@ -301,7 +313,7 @@ fn answer_timeout(link: Link) -> Duration {
 
 impl<T: Transport> Session<T> {
     /// A session with `form`'s nodes over `transport`; nothing is sent yet. Once the link is
-    /// e-stopped (see [`Gate`](super::estop::Gate)) the session fails with
+    /// e-stopped (see [`Gate`](super::transport::Gate)) the session fails with
     /// [`SessionError::Stopped`].
     pub fn new(transport: T, form: &FormDescription) -> Self {
         let nodes = form.node_ids().map(|n| (n, NodeStatus::default())).collect();
@@ -399,8 +411,9 @@ impl<T: Transport> Session<T> {
                 status.heartbeat_at = Some(Instant::now());
             }
             Message::Feedback(four) => {
-                let first = four.half.first();
-                status.positions[first..first + 4].copy_from_slice(&four.positions);
+                let mut all = Positions8 { positions: status.positions };
+                all.set_half(&four);
+                status.positions = all.positions;
             }
             Message::AllFeedback(all) => status.positions = all.positions,
             Message::Emergency(e) => status.events.push(e),
@@ -467,7 +480,7 @@ impl<T: Transport> Session<T> {
     /// heard before it began and how long the host's write of it took. It does not while the
     /// link is stalled (the write slept in the kernel longer than an answer may take, or
     /// nothing at all was heard meanwhile: on a loaded machine the tty layer can hold every
-    /// pty's bytes for a second, see `sim::bus::pty`), for up to [`LINK_STALL_LIMIT`] in a
+    /// pty's bytes for a second, see the simulator's `bus/pty.rs`), for up to [`LINK_STALL_LIMIT`] in a
     /// row: a dead link, or a host whose every write sleeps, is still reported.
     fn silence_counts(&mut self, heard_before: u64, wrote_for: Duration) -> bool {
         let stalled = wrote_for > answer_timeout(self.link()) || self.heard_count == heard_before;
@@ -502,18 +515,18 @@ impl<T: Transport> Session<T> {
         Ok(())
     }
 
-    /// Sends `packet` (addressed to `node`) until an answer for which `answered` holds comes
-    /// from it, up to [`ATTEMPTS`] times (attempts while the link stalls do not count).
-    async fn request(
-        &mut self,
-        packet: Packet,
-        name: &'static str,
-        mut answered: impl FnMut(&Message) -> bool,
-    ) -> Result<Message, SessionError> {
+    /// Sends `packet` (addressed to `node`) until its node has sent every answer the code
+    /// table names for it ([`Code::answers`]), or an `Ack` naming it; up to
+    /// [`ATTEMPTS`] times (attempts while the link stalls do not count). Returns the last
+    /// answer.
+    async fn request(&mut self, packet: Packet) -> Result<Message, SessionError> {
         let node = match packet.address {
             Address::Node(n) => n,
             Address::Broadcast => NodeId::MIN,
         };
+        let request = packet.message;
+        // What is still awaited; an answer heard in an earlier attempt counts.
+        let mut awaited = request.code().answers().to_vec();
         let attempts = ATTEMPTS;
         let mut made = 0;
         while made < attempts {
@@ -523,7 +536,11 @@ impl<T: Transport> Session<T> {
             let deadline = Instant::now() + answer_timeout(self.link());
             let answer = self
                 .receive_until(deadline, |p| {
-                    p.address == Address::Node(node) && answered(&p.message)
+                    if p.address != Address::Node(node) || !p.message.answers(&request) {
+                        return false;
+                    }
+                    awaited.retain(|&code| code != p.message.code());
+                    awaited.is_empty() || matches!(p.message, Message::Ack(_))
                 })
                 .await?;
             if let Some(answer) = answer {
@@ -534,7 +551,7 @@ impl<T: Transport> Session<T> {
                 made += 1;
             }
         }
-        Err(SessionError::NoAnswer { node: node.get(), request: name, attempts })
+        Err(SessionError::NoAnswer { node: node.get(), request: request_name(&request), attempts })
     }
 
     /// Host heartbeats (CAN) or polls (serial) when due.
@@ -641,24 +658,13 @@ impl<T: Transport> Session<T> {
             status.identity = None;
             status.capabilities = None;
         }
-        let answer = self
-            .request(Packet::node(node, Message::IdentifyRequest), "IdentifyRequest", |m| {
-                matches!(m, Message::Capabilities(_))
-            })
-            .await;
-        match answer {
+        // Both answers (Identity, then Capabilities), asking again until both are in.
+        match self.request(Packet::node(node, Message::IdentifyRequest)).await {
             Ok(_) => {}
             Err(SessionError::NoAnswer { .. }) => {
                 return Ok(vec![NodeProblem::Missing(node.get())]);
             }
             Err(e) => return Err(e),
-        }
-        // The Identity went first; if it was lost, ask again.
-        if self.nodes.get(&node).and_then(|s| s.identity).is_none() {
-            self.request(Packet::node(node, Message::IdentifyRequest), "IdentifyRequest", |m| {
-                matches!(m, Message::Identity(_))
-            })
-            .await?;
         }
         let status = self.nodes.get(&node).cloned().unwrap_or_default();
         let now = self.clock.tick();
@@ -692,26 +698,20 @@ impl<T: Transport> Session<T> {
             identity.actuator_count.to_string(),
             actuators.len().to_string(),
         );
-        let weakest = |f: &dyn Fn(&sim::form::ActuatorSpec) -> u16| {
-            actuators.iter().map(|a| f(a)).min().unwrap_or(0)
-        };
-        let stroke = weakest(&|a| a.stroke().hundredths_mm());
-        mismatch(
-            "stroke",
-            format!("{} mm", f64::from(caps.stroke.hundredths_mm()) / 100.0),
-            format!("{} mm", f64::from(stroke) / 100.0),
-        );
-        let speed = weakest(&|a| a.max_speed());
+        // A node reports the weakest of its actuators.
+        let stroke = actuators.iter().map(|a| a.stroke()).min().unwrap_or_default();
+        mismatch("stroke", format!("{} mm", caps.stroke.mm()), format!("{} mm", stroke.mm()));
+        let speed = actuators.iter().map(|a| a.max_speed()).min().unwrap_or_default();
         mismatch(
             "max speed",
-            format!("{} mm/s", f64::from(caps.max_speed) / 100.0),
-            format!("{} mm/s", f64::from(speed) / 100.0),
+            format!("{} mm/s", caps.max_speed.mm_s()),
+            format!("{} mm/s", speed.mm_s()),
         );
-        let accel = weakest(&|a| a.max_accel());
+        let accel = actuators.iter().map(|a| a.max_accel()).min().unwrap_or_default();
         mismatch(
             "max acceleration",
-            format!("{} mm/s²", f64::from(caps.max_accel) / 10.0),
-            format!("{} mm/s²", f64::from(accel) / 10.0),
+            format!("{} mm/s²", caps.max_accel.mm_s2()),
+            format!("{} mm/s²", accel.mm_s2()),
         );
         problems
     }
@@ -744,17 +744,9 @@ impl<T: Transport> Session<T> {
         node: NodeId,
         command: DriveCommand,
     ) -> Result<(), SessionError> {
-        let packet = Packet::node(node, Message::Control(command));
-        let name = match command {
-            DriveCommand::Disable => "Disable",
-            DriveCommand::Enable => "Enable",
-            DriveCommand::FaultReset => "FaultReset",
-            DriveCommand::Halt => "Halt",
-        };
-        let answer = self
-            .request(packet, name, |m| matches!(m, Message::Ack(a) if a.request == Code::Control))
-            .await?;
-        self.expect_ok(node, name, answer).await
+        let message = Message::Control(command);
+        let answer = self.request(Packet::node(node, message)).await?;
+        self.expect_ok(node, request_name(&message), answer).await
     }
 
     /// Checks a request's `Ack`; a refusal names the node's state and faults as a fresh
@@ -823,13 +815,7 @@ impl<T: Transport> Session<T> {
             self.nodes.get(&node).and_then(|s| s.heartbeat).map_or(ActuatorSet::EMPTY, |h| h.homed);
         let missing: ActuatorSet = wanted.iter().filter(|&a| !homed.contains(a)).collect();
         if !missing.is_empty() {
-            let answer = self
-                .request(
-                    Packet::node(node, Message::Home(missing)),
-                    "Home",
-                    |m| matches!(m, Message::Ack(a) if a.request == Code::Home),
-                )
-                .await?;
+            let answer = self.request(Packet::node(node, Message::Home(missing))).await?;
             self.expect_ok(node, "Home", answer).await?;
             // The heartbeat that follows shows Homing; forget the old one meanwhile.
             if let Some(status) = self.nodes.get_mut(&node) {

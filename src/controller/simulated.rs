@@ -8,10 +8,10 @@
 
 use std::path::PathBuf;
 
+use form_description::FormDescription;
 use sim::bus::can::{CanBus, CanKind};
 use sim::bus::candump::CandumpLog;
 use sim::fault::FaultSpec;
-use sim::form::FormDescription;
 use sim::robot::{FormState, SimError, SimOptions, SimulatedForm};
 
 use super::transport::sim::SimBus;
@@ -45,7 +45,7 @@ impl Default for SimConfig {
 /// Why a simulated drive failed.
 #[derive(Debug, thiserror::Error)]
 pub enum SimDriveError {
-    /// The simulated form could not start (invalid form or fault spec).
+    /// The simulated form could not start (a fault spec naming what the form lacks).
     #[error(transparent)]
     Sim(#[from] SimError),
     /// The candump log could not be created or written.

@@ -2,8 +2,9 @@
 //! ([`placement`]), and the actuator extensions that make each ring take the mannequin's
 //! section ([`rings`]), with a fidelity report.
 //!
-//! **Placement rule.** Rings named `neck`, `chest`, `waist` and `hip` are anchored to the
-//! mannequin's neck landmark and chest, waist and hip levels. Every other ring keeps its place
+//! **Placement rule.** A ring whose description states an `anchor` (`neck`, `chest`, `waist`,
+//! `hip`) is set to the mannequin's neck landmark or its chest, waist or hip level; a ring
+//! shapes the torso or the leg its `part` names. Every other ring keeps its place
 //! between its neighbours: its height maps piecewise-linearly through the anchors (below the
 //! lowest anchor and above the highest, with the nearest segment's scale). The reference form
 //! has no height adjustment, so each ring stays where it is built; the report says how far it
@@ -17,13 +18,13 @@ mod placement;
 mod rings;
 
 pub use outcome::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
-pub use placement::{Anchor, Placement};
+pub use placement::Placement;
 pub use rings::{RingFit, SHAPE_NOTE_MM, Saturation, region_of, ring_girth};
 
 use crate::profiles::Profiles;
 use crate::regions::Region;
+use form_description::FormDescription;
 use serde::Serialize;
-use sim::form::FormDescription;
 use std::collections::BTreeMap;
 
 /// The fit of a form to a mannequin.

@@ -10,8 +10,8 @@
 
 use std::collections::BTreeMap;
 
+use form_description::FormDescription;
 use serde::Serialize;
-use sim::form::FormDescription;
 
 use super::ring_girth;
 
@@ -119,7 +119,7 @@ mod tests {
 
     #[test]
     fn a_ring_off_by_more_than_the_tolerance_is_named_with_its_error() {
-        let form = sim::form::reference();
+        let form = form_description::reference();
         let retracted = BTreeMap::new();
         let waist = form.rings.iter().find(|r| r.name == "waist").unwrap();
         let smallest = ring_girth(&form, waist, &retracted);

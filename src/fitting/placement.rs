@@ -2,43 +2,16 @@
 //! above).
 
 use crate::profiles::Profiles;
-use serde::Serialize;
-use sim::form::FormDescription;
+use form_description::{Anchor, FormDescription};
 
-/// A ring anchored to a mannequin level.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Anchor {
-    /// The neck landmark.
-    Neck,
-    /// The chest level.
-    Chest,
-    /// The waist level.
-    Waist,
-    /// The hip level.
-    Hip,
-}
-
-impl Anchor {
-    /// The anchor of a ring of this name, if any.
-    pub fn of_ring(name: &str) -> Option<Anchor> {
-        match name {
-            "neck" => Some(Anchor::Neck),
-            "chest" => Some(Anchor::Chest),
-            "waist" => Some(Anchor::Waist),
-            "hip" => Some(Anchor::Hip),
-            _ => None,
-        }
-    }
-
-    /// The mannequin's height for this anchor.
-    fn level(self, p: &Profiles) -> f64 {
-        match self {
-            Anchor::Neck => p.landmarks.neck,
-            Anchor::Chest => p.levels.chest,
-            Anchor::Waist => p.levels.waist,
-            Anchor::Hip => p.levels.hip,
-        }
+/// The mannequin's height for a ring's anchor (the form description states which ring has
+/// which).
+fn level(anchor: Anchor, p: &Profiles) -> f64 {
+    match anchor {
+        Anchor::Neck => p.landmarks.neck,
+        Anchor::Chest => p.levels.chest,
+        Anchor::Waist => p.levels.waist,
+        Anchor::Hip => p.levels.hip,
     }
 }
 
@@ -55,7 +28,7 @@ impl Placement {
         let mut pairs: Vec<(f64, f64)> = form
             .rings
             .iter()
-            .filter_map(|r| Anchor::of_ring(&r.name).map(|a| (r.height_mm, a.level(profiles))))
+            .filter_map(|r| r.anchor.map(|a| (r.height_mm, level(a, profiles))))
             .collect();
         pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
         pairs.dedup_by(|a, b| a.0 == b.0);

@@ -9,14 +9,13 @@
 //! an actuator whose target lies beyond it is reported with the excess.
 
 use super::Placement;
-use super::placement::Anchor;
 use crate::profiles::{ProfileLayer, Profiles};
 use crate::regions::Region;
 use crate::slice::{Contour, convex_hull};
 use crate::symmetry::rays::cast_along;
+use form_description::{ActuatorSpec, Anchor, BodyPart, FormDescription, RingSpec};
 use glam::DVec2;
 use serde::Serialize;
-use sim::form::{ActuatorSpec, FormDescription, RingSpec};
 use std::collections::BTreeMap;
 
 /// The smallest shortfall reported as a shape note, mm: below it the gap is within what the
@@ -76,12 +75,12 @@ fn section_at(profiles: &Profiles, region: Region, z: f64) -> Option<Contour> {
     Some(Contour { points })
 }
 
-/// The mannequin region a ring shapes: the torso, or the leg on the side of an off-centre ring.
+/// The mannequin region a ring shapes, as its description states.
 pub fn region_of(ring: &RingSpec) -> Region {
-    match ring.center_mm[0] {
-        x if x > 1.0 => Region::LeftLeg,
-        x if x < -1.0 => Region::RightLeg,
-        _ => Region::Torso,
+    match ring.part {
+        BodyPart::Torso => Region::Torso,
+        BodyPart::LeftLeg => Region::LeftLeg,
+        BodyPart::RightLeg => Region::RightLeg,
     }
 }
 
@@ -114,6 +113,16 @@ fn skin_girth(centre: DVec2, actuators: &[&ActuatorSpec], extensions: &[f64]) ->
     Contour { points: convex_hull(&ends) }.perimeter()
 }
 
+/// Halvings of the common offset's bracket: it starts a few hundred mm wide, and 60 halvings
+/// leave it below the resolution of an `f64` of that size (2⁻⁶⁰ · 1000 mm ≈ 1e-15 mm).
+const BISECTION_STEPS: usize = 60;
+/// How far (mm) the bracket's ends lie beyond the offsets at which every panel is retracted
+/// and every panel is at full stroke, so that both ends are strictly outside.
+const BRACKET_MARGIN_MM: f64 = 1.0;
+/// A form girth within this of the mannequin's (mm) counts as matched: far below the
+/// millimetre a denoised mannequin's surface is known to ([`SHAPE_NOTE_MM`]).
+const GIRTH_MATCHED_MM: f64 = 0.01;
+
 /// Fits one ring; returns its report and the extensions of its actuators.
 pub(super) fn fit_ring(
     profiles: &Profiles,
@@ -130,7 +139,7 @@ pub(super) fn fit_ring(
     let centre = DVec2::from_array(ring.center_mm);
     let mut report = RingFit {
         ring: ring.name.clone(),
-        anchor: Anchor::of_ring(&ring.name),
+        anchor: ring.anchor,
         form_height_mm: ring.height_mm,
         mannequin_height_mm: z,
         offset_mm: ring.height_mm - z,
@@ -147,55 +156,88 @@ pub(super) fn fit_ring(
     };
     let directions: Vec<DVec2> =
         actuators.iter().map(|a| DVec2::from_array(a.direction())).collect();
-    let reach = cast_along(&section, centre, &directions);
+    let panels = Panels { centre, reach: cast_along(&section, centre, &directions), actuators };
     let target = section.tape_girth();
-    let raw = |delta: f64| -> Vec<f64> {
-        actuators.iter().zip(&reach).map(|(a, r)| r - a.base_radius_mm + delta).collect()
-    };
-    let clamped = |delta: f64| -> Vec<f64> {
-        raw(delta).iter().zip(&actuators).map(|(e, a)| e.clamp(0.0, a.stroke_mm)).collect()
-    };
-    let girth = |delta: f64| skin_girth(centre, &actuators, &clamped(delta));
-    // Bracket: below `lo` every panel is retracted, above `hi` every panel is at full stroke.
-    let spread = |f: fn(f64, f64) -> f64, init: f64| {
-        actuators.iter().zip(&reach).map(|(a, r)| r - a.base_radius_mm).fold(init, f)
-    };
-    let longest_stroke = actuators.iter().map(|a| a.stroke_mm).fold(0.0, f64::max);
-    let (mut lo, mut hi) = (
-        -spread(f64::max, f64::NEG_INFINITY) - 1.0,
-        longest_stroke - spread(f64::min, f64::INFINITY) + 1.0,
-    );
-    let delta = if girth(hi) <= target {
-        hi
-    } else if girth(lo) >= target {
-        lo
-    } else {
-        for _ in 0..60 {
+    let delta = panels.offset_for_girth(target);
+    let extensions = panels.clamped(delta);
+    report.mannequin_girth_mm = target;
+    report.form_girth_mm = skin_girth(centre, &panels.actuators, &extensions);
+    report.largest_radial_gap_mm = panels.largest_gap(&extensions);
+    // Where the girth is matched, the excess is measured at the solution; where the girth is out
+    // of reach, at the shape targets themselves (no common offset).
+    let matched = (report.form_girth_mm - target).abs() < GIRTH_MATCHED_MM;
+    report.saturated = panels.saturations(if matched { delta } else { 0.0 });
+    let ids = panels.actuators.iter().map(|a| a.id.clone());
+    Ok((report, ids.zip(extensions).collect()))
+}
+
+/// A ring's panels against the mannequin's section: where each actuator's direction meets it.
+struct Panels<'a> {
+    centre: DVec2,
+    actuators: Vec<&'a ActuatorSpec>,
+    /// Distance from the ring's axis to the section along each actuator's direction.
+    reach: Vec<f64>,
+}
+
+impl Panels<'_> {
+    /// The extensions that put every panel on the section, moved out by `delta` (unclamped).
+    fn raw(&self, delta: f64) -> Vec<f64> {
+        self.actuators.iter().zip(&self.reach).map(|(a, r)| r - a.base_radius_mm + delta).collect()
+    }
+
+    /// [`raw`](Self::raw) within each actuator's stroke.
+    fn clamped(&self, delta: f64) -> Vec<f64> {
+        let raw = self.raw(delta);
+        raw.iter().zip(&self.actuators).map(|(e, a)| e.clamp(0.0, a.stroke_mm)).collect()
+    }
+
+    /// The common radial offset whose clamped extensions give the skin `target` girth
+    /// (bisection); the bracket's end when the girth is out of reach.
+    fn offset_for_girth(&self, target: f64) -> f64 {
+        let girth = |delta: f64| skin_girth(self.centre, &self.actuators, &self.clamped(delta));
+        // Bracket: below `lo` every panel is retracted, above `hi` every panel is at full stroke.
+        let on_section =
+            || self.actuators.iter().zip(&self.reach).map(|(a, r)| r - a.base_radius_mm);
+        let longest_stroke = self.actuators.iter().map(|a| a.stroke_mm).fold(0.0, f64::max);
+        let (mut lo, mut hi) = (
+            -on_section().fold(f64::NEG_INFINITY, f64::max) - BRACKET_MARGIN_MM,
+            longest_stroke - on_section().fold(f64::INFINITY, f64::min) + BRACKET_MARGIN_MM,
+        );
+        if girth(hi) <= target {
+            return hi;
+        }
+        if girth(lo) >= target {
+            return lo;
+        }
+        for _ in 0..BISECTION_STEPS {
             let mid = 0.5 * (lo + hi);
             if girth(mid) < target { lo = mid } else { hi = mid }
         }
         0.5 * (lo + hi)
-    };
-    let extensions = clamped(delta);
-    report.mannequin_girth_mm = target;
-    report.form_girth_mm = skin_girth(centre, &actuators, &extensions);
-    report.largest_radial_gap_mm = actuators
-        .iter()
-        .zip(&reach)
-        .zip(&extensions)
-        .map(|((a, r), e)| (a.base_radius_mm + e - r).abs())
-        .fold(0.0, f64::max);
-    // Where the girth is matched, the excess is measured at the solution; where the girth is out
-    // of reach, at the shape targets themselves (no common offset).
-    let matched = (report.form_girth_mm - target).abs() < 0.01;
-    report.saturated = actuators
-        .iter()
-        .zip(raw(if matched { delta } else { 0.0 }))
-        .filter_map(|(a, e)| {
-            let beyond = if e > a.stroke_mm { e - a.stroke_mm } else { e.min(0.0) };
-            (beyond.abs() >= SHAPE_NOTE_MM)
-                .then(|| Saturation { actuator: a.id.clone(), beyond_mm: beyond })
-        })
-        .collect();
-    Ok((report, actuators.iter().map(|a| a.id.clone()).zip(extensions).collect()))
+    }
+
+    /// The largest distance between a panel at `extensions` and the section, along its
+    /// actuator's direction.
+    fn largest_gap(&self, extensions: &[f64]) -> f64 {
+        self.actuators
+            .iter()
+            .zip(&self.reach)
+            .zip(extensions)
+            .map(|((a, r), e)| (a.base_radius_mm + e - r).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// The actuators whose target at offset `delta` lies [`SHAPE_NOTE_MM`] or more beyond
+    /// their travel.
+    fn saturations(&self, delta: f64) -> Vec<Saturation> {
+        self.actuators
+            .iter()
+            .zip(self.raw(delta))
+            .filter_map(|(a, e)| {
+                let beyond = if e > a.stroke_mm { e - a.stroke_mm } else { e.min(0.0) };
+                (beyond.abs() >= SHAPE_NOTE_MM)
+                    .then(|| Saturation { actuator: a.id.clone(), beyond_mm: beyond })
+            })
+            .collect()
+    }
 }

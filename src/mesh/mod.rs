@@ -52,10 +52,37 @@ impl Aabb {
     }
 }
 
+/// A triangle naming a vertex the mesh does not have ([`Mesh::try_new`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("face {triangle} refers to vertex {index}, but there are only {vertices} vertices")]
+pub struct BadIndex {
+    /// The triangle (0-based).
+    pub triangle: usize,
+    /// The index it names.
+    pub index: u32,
+    /// How many vertices there are.
+    pub vertices: usize,
+}
+
 impl Mesh {
-    /// A mesh from positions and triangles (indices are not checked here; readers check them).
+    /// A mesh from positions and triangles whose indices are known to be in range (built by
+    /// code, not read from a file: files go through [`Mesh::try_new`]).
     pub fn new(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Self {
         Mesh { positions, triangles }
+    }
+
+    /// A mesh from positions and triangles, if every index names a vertex; else the first
+    /// triangle that does not. The readers' boundary: every decoded file passes here.
+    pub fn try_new(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Result<Self, BadIndex> {
+        let vertices = positions.len();
+        let bad = triangles.iter().enumerate().find_map(|(triangle, t)| {
+            let index = *t.iter().find(|&&i| i as usize >= vertices)?;
+            Some(BadIndex { triangle, index, vertices })
+        });
+        match bad {
+            Some(bad) => Err(bad),
+            None => Ok(Mesh { positions, triangles }),
+        }
     }
 
     /// The three corners of triangle `t`.
@@ -198,5 +225,19 @@ pub(crate) mod shapes {
         mesh.positions.extend([at, at + DVec3::X * s, at + DVec3::Y * s, at + DVec3::Z * s]);
         let [a, b, c, d] = [first, first + 1, first + 2, first + 3];
         mesh.triangles.extend([[a, c, b], [a, b, d], [a, d, c], [b, c, d]]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn try_new_refuses_an_index_past_the_vertices() {
+        let three = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+        assert!(Mesh::try_new(three.clone(), vec![[0, 1, 2]]).is_ok());
+        let bad = Mesh::try_new(three, vec![[0, 1, 2], [2, 3, 0]]).unwrap_err();
+        assert_eq!(bad, BadIndex { triangle: 1, index: 3, vertices: 3 });
+        assert_eq!(bad.to_string(), "face 1 refers to vertex 3, but there are only 3 vertices");
     }
 }

@@ -4,25 +4,9 @@
 use std::path::PathBuf;
 
 pub mod quality;
+mod skip;
 
-/// Whether the environment variable `var` is set to `1` (CI sets `DRESSFORM_REQUIRE_SHARED` and
-/// `DRESSFORM_REQUIRE_PEERS`).
-fn required(var: &str) -> bool {
-    std::env::var(var).is_ok_and(|v| v == "1")
-}
-
-/// `Some(found)`, or `None` after printing why the test is skipped; with `require_var=1` (as
-/// in CI) a missing `what` fails the test instead. The one place that decides "skip or fail".
-pub fn or_skip<T>(found: Result<T, String>, what: &str, require_var: &str) -> Option<T> {
-    match found {
-        Ok(t) => Some(t),
-        Err(why) => {
-            assert!(!required(require_var), "{require_var}=1 but {what} is unavailable: {why}");
-            eprintln!("SKIPPED: {what} is unavailable: {why}");
-            None
-        }
-    }
-}
+pub use skip::or_skip;
 
 /// The MakeHuman assets (`$DRESSFORM_MAKEHUMAN`, else `../shared/makehuman` beside the
 /// project), or `None` with a message when they are absent. With `DRESSFORM_REQUIRE_SHARED=1`

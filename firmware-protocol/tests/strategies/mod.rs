@@ -10,7 +10,8 @@ use firmware_protocol::message::{
 use firmware_protocol::param::ParamId;
 use firmware_protocol::version::FirmwareVersion;
 use firmware_protocol::{
-    Actuator, ActuatorSet, Address, Code, Message, NodeId, Packet, Position, ProtocolVersion,
+    Accel, Actuator, ActuatorSet, Address, Code, Message, NodeId, Packet, Position,
+    ProtocolVersion, Speed,
 };
 use proptest::prelude::*;
 use proptest::sample::select;
@@ -82,7 +83,11 @@ fn message() -> impl Strategy<Value = Message> {
         select(DriveCommand::ALL.to_vec()).prop_map(Message::Control),
         set().prop_map(Message::Home),
         (set(), any::<u16>(), any::<u16>()).prop_map(|(actuators, max_speed, max_accel)| {
-            Message::MotionLimits(MotionLimits { actuators, max_speed, max_accel })
+            Message::MotionLimits(MotionLimits {
+                actuators,
+                max_speed: Speed::from_hundredths_mm_s(max_speed),
+                max_accel: Accel::from_tenths_mm_s2(max_accel),
+            })
         }),
         Just(Message::IdentifyRequest),
         (protocol(), any::<(u8, u8, u8)>(), 1..=8u8).prop_map(
@@ -96,8 +101,8 @@ fn message() -> impl Strategy<Value = Message> {
             "a stroke is a position",
             |(stroke, max_speed, max_accel)| Some(Message::Capabilities(Capabilities {
                 stroke: stroke?,
-                max_speed,
-                max_accel,
+                max_speed: Speed::from_hundredths_mm_s(max_speed),
+                max_accel: Accel::from_tenths_mm_s2(max_accel),
             }))
         ),
         (any::<u16>(), actuator()).prop_map(|(id, actuator)| {

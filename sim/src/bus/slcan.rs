@@ -28,8 +28,8 @@
 
 use std::io;
 
-use embedded_can::Frame as _;
 use firmware_protocol::can::Frame;
+use firmware_protocol::slcan;
 use tokio::time::{Instant, interval};
 
 use super::can::{CanBus, CanPort};
@@ -98,8 +98,9 @@ impl SlcanAdapter {
                 }
                 received = self.port.recv_timed() => {
                     let Some(received) = received else { return Ok(()) };
-                    if self.channel != Channel::Closed && !received.frame.is_fd() {
-                        let line = self.frame_line(&received.frame, received.at);
+                    if self.channel != Channel::Closed
+                        && let Some(line) = self.frame_line(&received.frame, received.at)
+                    {
                         self.pty.queue(line.as_bytes());
                     }
                 }
@@ -148,8 +149,11 @@ impl SlcanAdapter {
                 self.channel = Channel::Closed;
                 true
             }
-            (Some('t'), frame) if self.channel == Channel::Open => {
-                return match parse_frame(frame).and_then(|f| self.port.queue(f).ok()) {
+            (Some('t'), _) if self.channel == Channel::Open => {
+                // A host sends no timestamps: a line with one is malformed.
+                let frame =
+                    slcan::parse(line.as_bytes()).and_then(|(f, at)| at.is_none().then_some(f));
+                return match frame.and_then(|f| self.port.queue(f).ok()) {
                     Some(()) => b"z\r".to_vec(),
                     None => ERROR.to_vec(),
                 };
@@ -188,47 +192,10 @@ impl SlcanAdapter {
         true
     }
 
-    /// `tIIILDD..[TTTT]\r` for a frame received at `at`.
-    fn frame_line(&self, frame: &Frame, at: Instant) -> String {
-        let mut line = format!("t{:03X}{}", frame.standard_id().as_raw(), frame.dlc());
-        for byte in frame.data() {
-            line.push_str(&format!("{byte:02X}"));
-        }
-        if self.timestamps {
-            let ms = at.saturating_duration_since(self.origin).as_millis() % 60_000;
-            line.push_str(&format!("{ms:04X}"));
-        }
-        line.push('\r');
-        line
-    }
-}
-
-/// Parses `IIILDD..` (the part after `t`): a standard id, a length 0..=8, the data in hex.
-fn parse_frame(text: &str) -> Option<Frame> {
-    let id = text.get(..3).and_then(|h| u16::from_str_radix(h, 16).ok())?;
-    let len = text.get(3..4).and_then(|l| l.parse::<usize>().ok()).filter(|&l| l <= 8)?;
-    let hex = text.get(4..)?;
-    if hex.len() != 2 * len || !hex.is_ascii() {
-        return None;
-    }
-    let data: Option<Vec<u8>> =
-        (0..len).map(|i| u8::from_str_radix(hex.get(2 * i..2 * i + 2)?, 16).ok()).collect();
-    Frame::new(embedded_can::StandardId::new(id)?, &data?)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn frames_parse_from_lawicel_text() {
-        let frame = parse_frame("2C31").map(|f| (f.standard_id().as_raw(), f.data().to_vec()));
-        assert_eq!(frame, None, "length 1 needs two hex digits");
-        let frame = parse_frame("2C3101").unwrap();
-        assert_eq!((frame.standard_id().as_raw(), frame.data()), (0x2C3, &[1][..]));
-        assert!(parse_frame("3800").is_some_and(|f| f.data().is_empty()));
-        for bad in ["800", "8000", "3809", "38", "2C31G1", "2C3101FF", "xyz0"] {
-            assert!(parse_frame(bad).is_none(), "{bad}");
-        }
+    /// `tIIILDD..[TTTT]\r` for a classic frame received at `at`.
+    fn frame_line(&self, frame: &Frame, at: Instant) -> Option<slcan::Line> {
+        let ms = at.saturating_duration_since(self.origin).as_millis() % 60_000;
+        // Below 60000, so it fits.
+        slcan::format(frame, self.timestamps.then_some(ms as u16))
     }
 }

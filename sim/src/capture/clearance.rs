@@ -119,7 +119,7 @@ fn closest_to_torso(a: &Anatomy, side: usize) -> Option<Violation> {
 
 /// Lowers the arm on `side` until it rests on the torso (pressing [`REST_PRESS_MM`] into
 /// it at the girth level where it comes closest); unchanged if no abduction does.
-pub(crate) fn rest_arm_on_torso(p: &mut BodyParams, side: usize) {
+fn rest_arm_on_torso(p: &mut BodyParams, side: usize) {
     let resting = (0..=400).rev().map(|k| f64::from(k) * 0.25).find(|&deg| {
         let mut q = p.clone();
         *abduction_mut(&mut q, side) = deg;
@@ -153,7 +153,7 @@ fn least_clear_abduction(p: &BodyParams, side: usize) -> Option<f64> {
 /// Checks that each arm clears the torso by [`LIMB_CLEARANCE_MM`] at the chest, waist and hip
 /// levels or rests on it (pressing at most [`MAX_PRESS_MM`] into it), and that each hand
 /// clears both thighs; the error names the arm's abduction and suggests a value that clears.
-pub(crate) fn check_clearances(a: &Anatomy, p: &BodyParams) -> Result<(), ParamError> {
+fn check_clearances(a: &Anatomy, p: &BodyParams) -> Result<(), ParamError> {
     let Some(v) = first_violation(a, &[0, 1], true) else {
         return Ok(());
     };
@@ -177,9 +177,43 @@ pub(crate) fn check_clearances(a: &Anatomy, p: &BodyParams) -> Result<(), ParamE
     })
 }
 
+impl BodyParams {
+    /// Checks every field against its allowed range (see the field docs), then that the arms
+    /// stay clear of the torso at the chest, waist and hip levels and the hands clear of the
+    /// thighs. The error names the first offending field.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        self.validate_ranges()?;
+        check_clearances(&Anatomy::new(self), self)
+    }
+
+    /// A random but plausible adult, reproducible from `seed`: stature 1500 ..= 1950 mm, builds
+    /// from slim to heavy, male- to female-typical proportions, and a varied A-pose (arms
+    /// 32 ..= 48 degrees, raised further when a heavy torso needs it). Always passes
+    /// [`BodyParams::validate`].
+    pub fn random(seed: u64) -> Self {
+        Self::sampled(seed).with_arms_clear()
+    }
+
+    /// These parameters with each arm raised, if needed, until it clears the torso at the
+    /// girth levels by the clearance rule's margin and its hand clears the thighs.
+    pub fn with_arms_clear(mut self) -> Self {
+        open_arms_until_clear(&mut self);
+        self
+    }
+
+    /// These parameters with the arm on the subject's left (`left`) or right side lowered
+    /// until it rests on the torso, as an arm hanging at the side does: it touches the torso
+    /// at the girth level where it comes closest. Passes [`BodyParams::validate`] when the
+    /// hand then clears the thighs.
+    pub fn with_arm_resting_on_torso(mut self, left: bool) -> Self {
+        rest_arm_on_torso(&mut self, if left { 0 } else { 1 });
+        self
+    }
+}
+
 /// Raises each arm's abduction to the least value at which it clears the torso and the hand
 /// the thighs (if one up to 100 degrees does); used by [`BodyParams::random`].
-pub(crate) fn open_arms_until_clear(p: &mut BodyParams) {
+fn open_arms_until_clear(p: &mut BodyParams) {
     for side in 0..2 {
         if let Some(deg) = least_clear_abduction(p, side) {
             *abduction_mut(p, side) = deg.max(*abduction_mut(p, side));

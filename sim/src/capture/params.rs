@@ -1,11 +1,10 @@
 //! What the synthetic customer is: body sizes ([`BodyParams`]) and how they stand ([`Pose`]),
 //! with the allowed ranges and the errors that name a field outside them ([`ParamError`]).
+//! The rules that need the body's geometry (the arms' clearance, [`BodyParams::validate`],
+//! [`BodyParams::random`]'s arms) are in `clearance`, which builds the anatomy from these.
 
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
-
-use super::anatomy::Anatomy;
-use super::clearance;
 
 /// Sizes of the synthetic body and its pose. Lengths in millimetres.
 ///
@@ -266,16 +265,9 @@ fn check_ratio(
 }
 
 impl BodyParams {
-    /// Checks every field against its allowed range (see the field docs), then that the arms
-    /// stay clear of the torso at the chest, waist and hip levels and the hands clear of the
-    /// thighs. The error names the first offending field.
-    pub fn validate(&self) -> Result<(), ParamError> {
-        self.validate_ranges()?;
-        clearance::check_clearances(&Anatomy::new(self), self)
-    }
-
-    /// Range checks of all fields, without the geometric clearance checks.
-    fn validate_ranges(&self) -> Result<(), ParamError> {
+    /// Range checks of all fields, without the geometric clearance checks (which
+    /// [`BodyParams::validate`] adds).
+    pub(crate) fn validate_ranges(&self) -> Result<(), ParamError> {
         check_range("height_mm", self.height_mm, 1400.0, 2100.0, " mm", "")?;
         check_range("chest_girth_mm", self.chest_girth_mm, 650.0, 1600.0, " mm", "")?;
         check_ratio(
@@ -350,11 +342,9 @@ impl BodyParams {
         Ok(())
     }
 
-    /// A random but plausible adult, reproducible from `seed`: stature 1500 ..= 1950 mm, builds
-    /// from slim to heavy, male- to female-typical proportions, and a varied A-pose (arms
-    /// 32 ..= 48 degrees, raised further when a heavy torso needs it). Always passes
-    /// [`BodyParams::validate`].
-    pub fn random(seed: u64) -> Self {
+    /// The sizes and pose of [`BodyParams::random`], before its arms are raised clear of the
+    /// torso.
+    pub(crate) fn sampled(seed: u64) -> Self {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let height = rng.random_range(1500.0..1950.0);
         let build: f64 = rng.random_range(0.0..1.0); // 0 = slim, 1 = heavy
@@ -394,26 +384,7 @@ impl BodyParams {
             params.waist_girth_mm.clamp(0.57 * params.chest_girth_mm, 1.12 * params.chest_girth_mm);
         params.hip_girth_mm =
             params.hip_girth_mm.clamp(0.82 * params.chest_girth_mm, 1.38 * params.chest_girth_mm);
-        clearance::open_arms_until_clear(&mut params);
         params
-    }
-}
-
-impl BodyParams {
-    /// These parameters with each arm raised, if needed, until it clears the torso at the
-    /// girth levels by the clearance rule's margin and its hand clears the thighs.
-    pub fn with_arms_clear(mut self) -> Self {
-        clearance::open_arms_until_clear(&mut self);
-        self
-    }
-
-    /// These parameters with the arm on the subject's left (`left`) or right side lowered
-    /// until it rests on the torso, as an arm hanging at the side does: it touches the torso
-    /// at the girth level where it comes closest. Passes [`BodyParams::validate`] when the
-    /// hand then clears the thighs.
-    pub fn with_arm_resting_on_torso(mut self, left: bool) -> Self {
-        clearance::rest_arm_on_torso(&mut self, if left { 0 } else { 1 });
-        self
     }
 }
 

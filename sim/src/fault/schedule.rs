@@ -8,8 +8,8 @@ use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
 
 use super::{BusFaults, FaultSpec, NodeFault, Window};
-use crate::form::FormDescription;
 use crate::node::ActuatorFault;
+use form_description::FormDescription;
 
 /// What a bus fault does to one frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

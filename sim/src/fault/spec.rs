@@ -6,8 +6,8 @@ use std::str::FromStr;
 use std::time::Duration;
 
 use super::{ActuatorFaultAt, FaultSpec, NodeFault, NodeFaultAt, Window};
-use crate::form::FormDescription;
 use crate::node::ActuatorFault;
+use form_description::FormDescription;
 
 /// A fault spec item that could not be understood, or names what the form lacks.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -293,7 +293,7 @@ mod tests {
 
     #[test]
     fn names_are_checked_against_the_form() {
-        let form = crate::form::reference();
+        let form = form_description::reference();
         assert!(SPEC.parse::<FaultSpec>().unwrap().check(&form).is_ok());
         let error = "node9:reboot@1s".parse::<FaultSpec>().unwrap().check(&form).unwrap_err();
         assert!(error.to_string().contains("no node 9"), "{error}");

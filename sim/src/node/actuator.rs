@@ -1,8 +1,8 @@
 //! One actuator of a node: its limits and parameters, its planned motion, and the physical
 //! panel it moves (which a jam or a broken encoder makes part ways with the plan).
 
-use firmware_protocol::Position;
 use firmware_protocol::update::shortest_duration_ms;
+use firmware_protocol::{Accel, Position, Speed};
 use tokio::time::Instant;
 
 use super::motion::{Limits, Profile};
@@ -161,8 +161,8 @@ impl ActuatorSim {
     /// The limits of the next move, in mm/s and mm/s².
     fn limits(&self) -> Limits {
         Limits {
-            speed: f64::from(self.params.max_speed.max(1)) / 100.0,
-            accel: f64::from(self.params.max_accel.max(1)) / 10.0,
+            speed: Speed::from_hundredths_mm_s(self.params.max_speed.max(1)).mm_s(),
+            accel: Accel::from_tenths_mm_s2(self.params.max_accel.max(1)).mm_s2(),
         }
     }
 
@@ -184,14 +184,15 @@ impl ActuatorSim {
     pub fn start_move(&mut self, now: Instant, target: Position, duration_ms: u16) -> Option<u32> {
         let (p0, v0) = self.planned(now);
         let limits = self.limits();
-        let p1 = f64::from(target.hundredths_mm()) / 100.0;
+        let p1 = target.mm();
         let fastest = Profile::fastest(p0, v0, p1, limits);
         let required_ms = if v0 == 0.0 {
             // From rest host and node share one integer formula.
             let from = (p0 * 100.0).round().clamp(0.0, f64::from(u16::MAX)) as u16;
             let distance = target.hundredths_mm().abs_diff(from);
-            shortest_duration_ms(distance, self.params.max_speed, self.params.max_accel)
-                .unwrap_or(u32::MAX)
+            let speed = Speed::from_hundredths_mm_s(self.params.max_speed);
+            let accel = Accel::from_tenths_mm_s2(self.params.max_accel);
+            shortest_duration_ms(distance, speed, accel).unwrap_or(u32::MAX)
         } else {
             let shortest = super::motion::shortest_time(v0, p1 - p0, limits);
             (shortest * 1000.0).ceil() as u32
@@ -209,7 +210,8 @@ impl ActuatorSim {
     /// Starts homing: forget the home and creep towards the home switch.
     pub fn start_homing(&mut self, now: Instant) {
         let (p, v) = self.planned(now);
-        let speed = f64::from(self.params.homing_speed.min(self.params.max_speed)) / 100.0;
+        let speed =
+            Speed::from_hundredths_mm_s(self.params.homing_speed.min(self.params.max_speed)).mm_s();
         self.homed = false;
         self.staged = None;
         self.homing = Some(Homing::Seek);

@@ -64,8 +64,8 @@ use firmware_protocol::message::{
 };
 use firmware_protocol::version::FirmwareVersion;
 use firmware_protocol::{
-    Actuator, ActuatorSet, Address, Code, Link, Message, NodeId, PROTOCOL_VERSION, Packet,
-    Position, ProtocolVersion,
+    Accel, Actuator, ActuatorSet, Address, Code, Link, Message, NodeId, PROTOCOL_VERSION, Packet,
+    Position, ProtocolVersion, Speed,
 };
 use rand::SeedableRng;
 use rand::rngs::ChaCha8Rng;
@@ -622,13 +622,15 @@ impl Node {
     /// node lacks are ignored), from the next SYNC.
     fn motion_limits(&mut self, limits: MotionLimits) -> AckStatus {
         let (speed, accel) = self.speed_and_accel_capability();
-        if !(1..=speed).contains(&limits.max_speed) || !(1..=accel).contains(&limits.max_accel) {
+        let (max_speed, max_accel) =
+            (limits.max_speed.hundredths_mm_s(), limits.max_accel.tenths_mm_s2());
+        if !(1..=speed).contains(&max_speed) || !(1..=accel).contains(&max_accel) {
             return AckStatus::InvalidArgument;
         }
         for index in limits.actuators.iter() {
             if let Some(actuator) = self.actuators.get_mut(index.index()) {
-                actuator.params.max_speed = limits.max_speed;
-                actuator.params.max_accel = limits.max_accel;
+                actuator.params.max_speed = max_speed;
+                actuator.params.max_accel = max_accel;
             }
         }
         AckStatus::Ok
@@ -645,8 +647,12 @@ impl Node {
     /// The weakest of its actuators.
     fn capabilities(&self) -> Capabilities {
         let stroke = self.actuators.iter().map(|a| a.config.stroke).min();
-        let (max_speed, max_accel) = self.speed_and_accel_capability();
-        Capabilities { stroke: stroke.unwrap_or(Position::ZERO), max_speed, max_accel }
+        let (speed, accel) = self.speed_and_accel_capability();
+        Capabilities {
+            stroke: stroke.unwrap_or(Position::ZERO),
+            max_speed: Speed::from_hundredths_mm_s(speed),
+            max_accel: Accel::from_tenths_mm_s2(accel),
+        }
     }
 
     fn speed_and_accel_capability(&self) -> (u16, u16) {

@@ -189,6 +189,7 @@ fn knots(p0: f64, v0: f64, vc: f64, duration: f64, accel: f64) -> Vec<Knot> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use firmware_protocol::{Accel, Speed};
 
     const LIMITS: Limits = Limits { speed: 10.0, accel: 100.0 };
 
@@ -209,7 +210,8 @@ mod tests {
         // 50 mm at 10 mm/s with 100 mm/s²: 5.1 s, as `update::shortest_duration_ms` says.
         let t = shortest_time(0.0, 50.0, LIMITS);
         assert!((t - 5.1).abs() < 1e-9, "{t}");
-        assert_eq!(firmware_protocol::update::shortest_duration_ms(5000, 1000, 1000), Some(5100));
+        let (speed, accel) = (Speed::from_mm_s(10.0).unwrap(), Accel::from_mm_s2(100.0).unwrap());
+        assert_eq!(firmware_protocol::update::shortest_duration_ms(5000, speed, accel), Some(5100));
         // A triangle: 1 mm takes 2·√(1/100) = 0.2 s.
         assert!((shortest_time(0.0, 1.0, LIMITS) - 0.2).abs() < 1e-9);
     }

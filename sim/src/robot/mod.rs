@@ -8,7 +8,7 @@
 //! use sim::robot::{SimOptions, SimulatedForm};
 //!
 //! let bus = CanBus::new(CanKind::CLASSIC_1M);
-//! let form = SimulatedForm::on_can(&sim::form::reference(), &bus, &FaultSpec::default(),
+//! let form = SimulatedForm::on_can(&form_description::reference(), &bus, &FaultSpec::default(),
 //!                                  &SimOptions::default())?;
 //! let mut host = bus.attach();          // the host controller's port
 //! let frame = host.recv().await;        // boot-up heartbeats, feedback, ...
@@ -37,8 +37,8 @@ use tokio::time::{Duration, Instant};
 use crate::bus::can::CanBus;
 use crate::bus::serial::SerialLine;
 use crate::fault::{FaultSpec, FaultSpecError, NodeSchedule};
-use crate::form::{FormDescription, FormError};
 use crate::node::{ActuatorConfig, ActuatorFault, ActuatorState, Node, NodeConfig};
+use form_description::FormDescription;
 use node_sim::NodeSim;
 use runners::{SharedCanary, SharedNode, Stalls, lock};
 
@@ -74,9 +74,6 @@ impl Default for SimOptions {
 /// Why a simulated form could not start.
 #[derive(Debug, thiserror::Error)]
 pub enum SimError {
-    /// The description is invalid.
-    #[error(transparent)]
-    Form(#[from] FormError),
     /// The fault spec names what the form lacks.
     #[error(transparent)]
     Faults(#[from] FaultSpecError),
@@ -293,8 +290,8 @@ pub fn node_config(
         .into_iter()
         .map(|a| ActuatorConfig {
             stroke: a.stroke(),
-            max_speed: a.max_speed(),
-            max_accel: a.max_accel(),
+            max_speed: a.max_speed().hundredths_mm_s(),
+            max_accel: a.max_accel().tenths_mm_s2(),
             start_mm: options.start_position_mm.max(0.0).min(a.stroke_mm),
         })
         .collect();
@@ -308,7 +305,7 @@ pub fn node_config(
     }
 }
 
-/// Validates the description and the faults, and powers every node on.
+/// Checks the faults against the (validated) description, and powers every node on.
 fn power_on(
     description: &FormDescription,
     link: Link,
@@ -316,7 +313,6 @@ fn power_on(
     options: &SimOptions,
     origin: Instant,
 ) -> Result<Vec<SharedNode>, SimError> {
-    description.validate().map_err(|problems| FormError::Invalid { path: None, problems })?;
     faults.check(description)?;
     let now = Instant::now();
     Ok(description

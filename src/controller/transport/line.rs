@@ -2,7 +2,7 @@
 //! adapter or a pseudo-terminal alike); a reader thread turns the bytes into packets with the
 //! link's parser and hands them to tokio through a channel; writes are small (at most a
 //! frame) and go straight to the port through a second handle, which the link's
-//! [`Gate`](super::super::estop::Gate) owns (so an e-stop never waits for the reader).
+//! [`Gate`](super::gate::Gate) owns (so an e-stop never waits for the reader).
 
 use std::io::{ErrorKind, Read, Write};
 use std::path::Path;

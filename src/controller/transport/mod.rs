@@ -16,6 +16,7 @@
 //! CAN or slcan) are refused with [`TransportError::Unsupported`] before anything is sent;
 //! the session asks [`Transport::link`] and sends `Targets` halves on classic links.
 
+pub mod gate;
 pub mod serial;
 pub mod sim;
 pub mod slcan;
@@ -28,7 +29,7 @@ use std::path::PathBuf;
 
 use firmware_protocol::{Link, Packet};
 
-use super::estop::{Gate, StopCause};
+pub use gate::{EMERGENCY_STOP_REPEATS, Gate, PacketSink, StopCause};
 
 /// Why a link failed.
 #[derive(Debug, thiserror::Error)]

@@ -11,9 +11,9 @@ use std::path::Path;
 
 use firmware_protocol::{Link, Packet, serial};
 
+use super::gate::{Gate, PacketSink};
 use super::line::{Line, Writer};
 use super::{Transport, TransportError};
-use crate::controller::estop::{Gate, PacketSink};
 
 /// The line speed of the serial mapping.
 pub const BAUD: u32 = 1_000_000;

@@ -4,8 +4,8 @@
 use firmware_protocol::{Link, Packet, can};
 use sim::bus::can::{CanBus, CanReceiver, CanSender};
 
+use super::gate::{Gate, PacketSink};
 use super::{Transport, TransportError};
-use crate::controller::estop::{Gate, PacketSink};
 
 /// The name of the simulated link in messages.
 const DEVICE: &str = "simulated bus";

@@ -13,11 +13,11 @@
 
 use std::path::Path;
 
-use firmware_protocol::{Link, Packet, can};
+use firmware_protocol::{Link, Packet, can, slcan};
 
+use super::gate::{Gate, PacketSink};
 use super::line::{Line, Writer};
 use super::{Transport, TransportError};
-use crate::controller::estop::{Gate, PacketSink};
 
 /// The longest line kept while parsing (a frame line is at most 26 characters).
 const MAX_LINE: usize = 64;
@@ -42,7 +42,8 @@ impl PacketSink for Lines {
             what: format!("{} ({what})", packet.message.code().name()),
         };
         let frame = can::encode(packet).map_err(|e| unsupported(&e.to_string()))?;
-        let text = format_frame(&frame).ok_or_else(|| unsupported("not a classic CAN frame"))?;
+        let text =
+            slcan::format(&frame, None).ok_or_else(|| unsupported("not a classic CAN frame"))?;
         self.0.write(text.as_bytes())
     }
 }
@@ -70,38 +71,11 @@ impl Slcan {
     }
 }
 
-/// The slcan text of a classic frame: `tIIILDD..\r`.
-pub fn format_frame(frame: &can::Frame) -> Option<String> {
-    use embedded_can::Frame as _;
-    let embedded_can::Id::Standard(id) = frame.id() else { return None };
-    if frame.is_fd() || frame.data().len() > 8 {
-        return None;
-    }
-    let mut text = format!("t{:03X}{}", id.as_raw(), frame.data().len());
-    for byte in frame.data() {
-        text.push_str(&format!("{byte:02X}"));
-    }
-    text.push('\r');
-    Some(text)
-}
-
-/// The packet of a received line, if it is a valid protocol frame.
+/// The packet of a received line (`firmware_protocol::slcan`'s frame line, the timestamp
+/// ignored; a `z` acknowledgement may run into it), if it is a valid protocol frame.
 pub fn parse_line(line: &[u8]) -> Option<Packet> {
-    use embedded_can::Frame as _;
-    let text = std::str::from_utf8(line).ok()?;
-    let text = text.strip_prefix('z').unwrap_or(text);
-    let rest = text.strip_prefix('t')?;
-    let id = u16::from_str_radix(rest.get(0..3)?, 16).ok()?;
-    let len = usize::from(rest.get(3..4)?.parse::<u8>().ok()?);
-    if len > 8 {
-        return None;
-    }
-    let hex = rest.get(4..4 + 2 * len)?;
-    let data: Vec<u8> = (0..len)
-        .map(|i| u8::from_str_radix(hex.get(2 * i..2 * i + 2)?, 16).ok())
-        .collect::<Option<_>>()?;
-    let id = embedded_can::StandardId::new(id)?;
-    let frame = can::Frame::new(id, &data)?;
+    let line = line.strip_prefix(b"z").unwrap_or(line);
+    let (frame, _timestamp) = slcan::parse(line)?;
     can::decode(&frame).ok()
 }
 
@@ -130,18 +104,16 @@ mod tests {
     use firmware_protocol::{Message, NodeId};
 
     #[test]
-    fn frames_round_trip_through_slcan_text() {
+    fn received_lines_become_packets() {
         let node = NodeId::new(3).unwrap();
         let packet =
             Packet::node(node, Message::Control(firmware_protocol::drive::DriveCommand::Enable));
-        let text = format_frame(&can::encode(&packet).unwrap()).unwrap();
-        assert_eq!(text, "t2C3101\r");
+        let text = slcan::format(&can::encode(&packet).unwrap(), None).unwrap();
         assert_eq!(parse_line(text.trim_end().as_bytes()), Some(packet));
+        // A timestamped line, one an acknowledgement ran into, and what is not a frame.
         let sync = Packet::broadcast(Message::Sync(Sync { duration_ms: 2000 }));
-        let text = format_frame(&can::encode(&sync).unwrap()).unwrap();
-        assert_eq!(text, "t0402D007\r");
-        // A timestamped line, and what is not a frame.
         assert_eq!(parse_line(b"t0402D0071234"), Some(sync));
+        assert_eq!(parse_line(b"zt0402D007"), Some(sync));
         assert_eq!(parse_line(b"z"), None);
         assert_eq!(parse_line(b"t04"), None);
         assert_eq!(parse_line(b"T0000004000"), None);

@@ -16,8 +16,8 @@ use embedded_can::Frame as _;
 use firmware_protocol::{Link, Packet, can};
 use socketcan::{CanFrame, Socket as _, tokio::CanSocket};
 
+use super::gate::{Gate, PacketSink};
 use super::{Transport, TransportError};
-use crate::controller::estop::{Gate, PacketSink};
 
 /// The longest a frame write waits for room in the interface's queue.
 const WRITE_TIMEOUT: Duration = Duration::from_millis(10);

@@ -101,7 +101,14 @@ impl Format {
         if file.mesh.triangles.is_empty() {
             return Err(ReadError::NoFaces);
         }
-        Ok(file)
+        let MeshFile { mesh: Mesh { positions, triangles }, comments } = file;
+        let mesh =
+            Mesh::try_new(positions, triangles).map_err(|bad| ReadError::IndexOutOfRange {
+                face: bad.triangle,
+                index: i64::from(bad.index),
+                vertices: bad.vertices,
+            })?;
+        Ok(MeshFile { mesh, comments })
     }
 
     /// Parses `bytes` in this format (the mesh only).

@@ -7,7 +7,7 @@ use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 
 fuzz_target!(|bytes: &[u8]| {
-    let form = sim::form::reference();
+    let form = form_description::reference();
     let regions = dressform::fitting::regions_of(&form);
     let Ok(text) = std::str::from_utf8(bytes) else { return };
     if let Ok(profiles) = Profiles::parse(text, Path::new("fuzz.json"), &regions) {

@@ -9,7 +9,7 @@ use std::path::Path;
 fuzz_target!(|bytes: &[u8]| {
     let Ok(text) = std::str::from_utf8(bytes) else { return };
     let Ok(points) = SetPoints::from_json_str(text, Path::new("fuzz.json")) else { return };
-    let form = sim::form::reference();
+    let form = form_description::reference();
     let _ = points.validate(&form);
     for clamp in [false, true] {
         if let Ok(checked) = points.check(&form, clamp) {

@@ -6,7 +6,7 @@ use std::fmt;
 use firmware_protocol::actuator::MAX_ACTUATORS;
 use firmware_protocol::{NodeId, Position};
 
-use super::description::{ActuatorSpec, FormDescription, RingSpec};
+use super::description::{ActuatorSpec, BodyPart, FormDescription, FormSpec, RingSpec};
 
 /// Largest speed the wire carries (`u16` in 0.01 mm/s), mm/s.
 const MAX_SPEED_MM_S: f64 = 655.35;
@@ -210,9 +210,18 @@ impl fmt::Display for Problem {
     }
 }
 
-impl FormDescription {
+impl TryFrom<FormSpec> for FormDescription {
+    type Error = Vec<Problem>;
+
+    /// Validates `spec` (see the crate's rules); `Err` lists every problem found.
+    fn try_from(spec: FormSpec) -> Result<Self, Vec<Problem>> {
+        spec.problems().map(|()| FormDescription(spec))
+    }
+}
+
+impl FormSpec {
     /// Checks the description; `Err` lists every problem found.
-    pub fn validate(&self) -> Result<(), Vec<Problem>> {
+    fn problems(&self) -> Result<(), Vec<Problem>> {
         let mut problems = Vec::new();
         self.check_nodes(&mut problems);
         self.check_rings(&mut problems);
@@ -263,10 +272,28 @@ impl FormDescription {
                     problem,
                 });
             }
+            if let Some(problem) = part_problem(ring) {
+                problems.push(Problem::RingValue { ring: name.clone(), field: "part", problem });
+            }
+            if let Some(problem) = self.anchor_problem(ring) {
+                problems.push(Problem::RingValue { ring: name.clone(), field: "anchor", problem });
+            }
             if let Some(problem) = self.ring_mirror_problem(ring) {
                 problems.push(Problem::RingMirror { ring: name, problem });
             }
         }
+    }
+
+    /// An anchor on a leg ring, or one another ring (earlier in the file) already has.
+    fn anchor_problem(&self, ring: &RingSpec) -> Option<String> {
+        let anchor = ring.anchor?;
+        if ring.part != BodyPart::Torso {
+            return Some(format!("\"{}\" is a torso level; a leg ring has none", anchor.name()));
+        }
+        let first = self.rings.iter().find(|r| r.anchor == Some(anchor))?;
+        (first.name != ring.name).then(|| {
+            format!("\"{}\" is already the anchor of ring `{}`", anchor.name(), first.name)
+        })
     }
 
     fn ring_mirror_problem(&self, ring: &RingSpec) -> Option<String> {
@@ -325,7 +352,7 @@ impl FormDescription {
                     channel: a.channel,
                 });
             }
-            let max_stroke = f64::from(Position::MAX.mm());
+            let max_stroke = Position::MAX.mm();
             let checks: [(&'static str, f64, bool, &'static str); 6] = [
                 ("angle_deg", a.angle_deg, (0.0..360.0).contains(&a.angle_deg), "in [0, 360)"),
                 ("base_radius_mm", a.base_radius_mm, a.base_radius_mm > 0.0, "> 0"),
@@ -469,6 +496,24 @@ impl FormDescription {
             .find(|(_, x, y)| !close(*x, *y))
             .map(|(field, x, y)| format!("`{field}` differs ({x} and {y})"))
     }
+}
+
+/// A ring's part against its centre: a torso ring on the body axis (x = 0), a leg ring on its
+/// own side.
+fn part_problem(ring: &RingSpec) -> Option<String> {
+    let x = ring.center_mm[0];
+    let fits = match ring.part {
+        BodyPart::Torso => x == 0.0,
+        BodyPart::LeftLeg => x > 0.0,
+        BodyPart::RightLeg => x < 0.0,
+    };
+    (!fits && x.is_finite()).then(|| match ring.part {
+        BodyPart::Torso => format!(
+            "the ring is off the body axis (x = {x} mm): a leg ring says \
+             `part = \"left-leg\"` (x > 0) or `\"right-leg\"` (x < 0)"
+        ),
+        leg => format!("\"{}\" needs its centre on that side (x = {x} mm)", leg.name()),
+    })
 }
 
 fn close(a: f64, b: f64) -> bool {

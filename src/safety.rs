@@ -18,7 +18,7 @@ impl SafeTarget {
     /// `mm` rounded to 0.01 mm, if it lies in `[0, stroke]`; `None` otherwise (or if it is
     /// not a number).
     pub fn within(mm: f64, stroke: Position) -> Option<Self> {
-        if !(0.0..=f64::from(stroke.hundredths_mm()) / 100.0).contains(&mm) {
+        if !(0.0..=stroke.mm()).contains(&mm) {
             return None;
         }
         let hundredths = (mm * 100.0).round();
@@ -42,7 +42,7 @@ impl SafeTarget {
 
     /// The target in mm.
     pub fn mm(self) -> f64 {
-        f64::from(self.0.hundredths_mm()) / 100.0
+        self.0.mm()
     }
 }
 

@@ -1,16 +1,24 @@
-//! The description's types, its TOML loaders, look-ups and geometry.
+//! The description's types: what a file says ([`FormSpec`], unchecked) and the validated
+//! [`FormDescription`]; look-ups and geometry.
 
-use std::path::Path;
+use std::ops::Deref;
 
-use firmware_protocol::{Actuator, NodeId, Position};
+use firmware_protocol::{Accel, Actuator, NodeId, Position, Speed};
 use serde::{Deserialize, Serialize};
 
-use super::FormError;
+/// A robotic dress form that passed validation: its nodes, the rings its actuators sit on,
+/// and the actuators. The only ways to get one are the loaders and `FormDescription::try_from`
+/// a [`FormSpec`], which validate; it reads as its [`FormSpec`] (through `Deref`) and cannot
+/// be changed.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(transparent)]
+pub struct FormDescription(pub(crate) FormSpec);
 
-/// A robotic dress form: its nodes, the rings its actuators sit on, and the actuators.
+/// What a form description file says, not yet validated: deserialise into this, then
+/// [`FormDescription::try_from`] it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct FormDescription {
+pub struct FormSpec {
     /// A name for people and logs.
     pub name: String,
     /// The controller boards on the bus (`[[node]]`).
@@ -50,6 +58,68 @@ pub struct RingSpec {
     /// For an off-centre ring: the ring that mirrors it across x = 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mirror: Option<String>,
+    /// The part of the body it shapes: the torso (default) or a leg.
+    #[serde(default, skip_serializing_if = "BodyPart::is_torso")]
+    pub part: BodyPart,
+    /// The mannequin level the ring is set to, if any (the other rings are placed between
+    /// the anchored ones).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anchor: Option<Anchor>,
+}
+
+/// The part of the body a ring shapes. A torso ring is centred on the body axis (x = 0); a
+/// leg ring sits on its leg's side.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BodyPart {
+    /// The torso.
+    #[default]
+    Torso,
+    /// The subject's left leg (+X).
+    LeftLeg,
+    /// The subject's right leg (-X).
+    RightLeg,
+}
+
+impl BodyPart {
+    fn is_torso(&self) -> bool {
+        *self == BodyPart::Torso
+    }
+
+    /// Its name in a description file.
+    pub fn name(self) -> &'static str {
+        match self {
+            BodyPart::Torso => "torso",
+            BodyPart::LeftLeg => "left-leg",
+            BodyPart::RightLeg => "right-leg",
+        }
+    }
+}
+
+/// A mannequin level a ring can be set to (each at most once per form).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Anchor {
+    /// The neck landmark.
+    Neck,
+    /// The chest level.
+    Chest,
+    /// The waist level.
+    Waist,
+    /// The hip level.
+    Hip,
+}
+
+impl Anchor {
+    /// Its name in a description file.
+    pub fn name(self) -> &'static str {
+        match self {
+            Anchor::Neck => "neck",
+            Anchor::Chest => "chest",
+            Anchor::Waist => "waist",
+            Anchor::Hip => "hip",
+        }
+    }
 }
 
 fn is_origin(center: &[f64; 2]) -> bool {
@@ -92,15 +162,14 @@ impl ActuatorSpec {
         Position::from_mm(self.stroke_mm as f32).unwrap_or(Position::ZERO)
     }
 
-    /// The speed limit in the protocol's unit, 0.01 mm/s.
-    pub fn max_speed(&self) -> u16 {
-        // `as` saturates (and maps NaN to 0); validation keeps the value in range.
-        (self.max_speed_mm_s * 100.0).round() as u16
+    /// The speed limit in the protocol's unit (validation keeps it in range).
+    pub fn max_speed(&self) -> Speed {
+        Speed::from_mm_s(self.max_speed_mm_s).unwrap_or_default()
     }
 
-    /// The acceleration limit in the protocol's unit, 0.1 mm/s².
-    pub fn max_accel(&self) -> u16 {
-        (self.max_accel_mm_s2 * 10.0).round() as u16
+    /// The acceleration limit in the protocol's unit (validation keeps it in range).
+    pub fn max_accel(&self) -> Accel {
+        Accel::from_mm_s2(self.max_accel_mm_s2).unwrap_or_default()
     }
 
     /// Its node's id, if the address is valid.
@@ -120,35 +189,23 @@ impl ActuatorSpec {
     }
 }
 
+impl Deref for FormDescription {
+    type Target = FormSpec;
+
+    fn deref(&self) -> &FormSpec {
+        &self.0
+    }
+}
+
 impl FormDescription {
-    /// Parses and validates a TOML description.
-    pub fn from_toml_str(text: &str) -> Result<Self, FormError> {
-        let form: Self =
-            toml::from_str(text).map_err(|source| FormError::Toml { path: None, source })?;
-        form.validate().map_err(|problems| FormError::Invalid { path: None, problems })?;
-        Ok(form)
+    /// The unchecked description, to edit (a copy of a form with one change) and validate
+    /// again.
+    pub fn into_spec(self) -> FormSpec {
+        self.0
     }
+}
 
-    /// Reads, parses and validates a TOML description file; errors name the file.
-    pub fn load(path: impl AsRef<Path>) -> Result<Self, FormError> {
-        let path = path.as_ref();
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| FormError::Io { path: path.to_owned(), source })?;
-        Self::from_toml_str(&text).map_err(|error| match error {
-            FormError::Toml { source, .. } => FormError::Toml { path: Some(path.into()), source },
-            FormError::Invalid { problems, .. } => {
-                FormError::Invalid { path: Some(path.into()), problems }
-            }
-            io => io,
-        })
-    }
-
-    /// The description as TOML (what [`from_toml_str`](Self::from_toml_str) reads back).
-    pub fn to_toml_string(&self) -> String {
-        // Plain structs of strings, numbers and arrays always serialise.
-        toml::to_string(self).unwrap_or_default()
-    }
-
+impl FormSpec {
     /// The nodes' ids, in file order (valid addresses only).
     pub fn node_ids(&self) -> impl Iterator<Item = NodeId> + '_ {
         self.nodes.iter().filter_map(|n| NodeId::new(n.address))

@@ -10,9 +10,9 @@
 //! (a FaultReset, an Enable, a target) can undo the stop. Whoever waits on
 //! [`Gate::watch`] learns of the stop once the frames are out.
 //!
-//! The callers: the local control endpoint ([`super::control`], `dressform estop` from
-//! another terminal), the command line's signal thread (SIGINT, SIGTERM, SIGHUP), and
-//! [`super::emergency_stop`] on a link the caller opened itself.
+//! The callers: the local control endpoint ([`crate::controller::control`], `dressform estop`
+//! from another terminal), the command line's signal thread (SIGINT, SIGTERM, SIGHUP), and
+//! [`crate::controller::emergency_stop`] on a link the caller opened itself.
 
 use std::fmt;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
@@ -20,7 +20,7 @@ use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use firmware_protocol::{Message, Packet};
 use tokio::sync::watch;
 
-use super::transport::TransportError;
+use super::TransportError;
 
 /// How many times an emergency stop is broadcast: nodes act on the first that arrives, and
 /// three make a frame lost on a 5 %-lossy bus a one-in-8000 event.
@@ -40,7 +40,7 @@ pub enum StopCause {
     Remote,
     /// A signal to this process (`SIGINT`, `SIGTERM`, `SIGHUP`).
     Signal(&'static str),
-    /// This process's own request ([`super::emergency_stop`]).
+    /// This process's own request ([`crate::controller::emergency_stop`]).
     Requested,
 }
 

@@ -1,9 +1,11 @@
 //! Form descriptions: which nodes a robotic dress form has, which actuators they drive, and
-//! where those actuators push on the body.
+//! where those actuators push on the body — what the dressform host and the form's nodes
+//! (real or simulated) agree on besides the wire protocol.
 //!
 //! A description is TOML ([`FormDescription::from_toml_str`], [`FormDescription::load`]);
-//! [`reference()`] is the form shipped in `sim/forms/reference.toml` (64 actuators on 8 nodes,
-//! neck to mid-thigh). The root package and the simulator both read descriptions from here.
+//! [`reference()`] is the form shipped in `forms/reference.toml` (64 actuators on 8 nodes,
+//! neck to mid-thigh). The host (`dressform`: fitting, set-points, the controller) and the
+//! simulator (`sim`) both read descriptions from here; this crate knows nothing of either.
 //!
 //! ```toml
 //! name = "reference"
@@ -16,6 +18,8 @@
 //! name = "chest"
 //! height_mm = 1280.0     # height of the ring above the floor
 //! center_mm = [0.0, 0.0] # optional: the ring's axis in the X-Y plane (default: body axis)
+//! anchor = "chest"       # optional: set to the mannequin's neck, chest, waist or hip level
+//! # part = "left-leg"    # what it shapes: "torso" (default), "left-leg" or "right-leg"
 //! # mirror = "..."       # off-centre rings (thighs) name their mirror ring
 //!
 //! [[actuator]]
@@ -46,14 +50,20 @@
 //! `360 - a`, with the same stroke, limits, base radius and panel width. Actuators on the
 //! centre line (0° or 180° on a ring centred on the body axis) are their own mirror.
 //!
-//! **Validation** ([`FormDescription::validate`], run by the loaders) reports every problem
-//! at once, each naming the node, ring or actuator and the field: node addresses outside
+//! **Ring roles.** A ring states what it shapes (`part`: a torso ring is centred on x = 0, a
+//! leg ring sits on its leg's side) and, for the rings set to a mannequin level, that level
+//! (`anchor`, each at most once); nothing is guessed from a ring's name or position.
+//!
+//! **Validation.** A [`FormDescription`] exists only validated: the loaders and
+//! `FormDescription::try_from(`[`FormSpec`]`)` (what a file says, unchecked) report every
+//! problem at once, each naming the node, ring or actuator and the field: node addresses outside
 //! 1..=63 or used twice, nodes without actuators, duplicate ids, unknown nodes or rings,
 //! channels outside 0..=7, used twice or not numbered 0..n-1 on a node (the protocol numbers
 //! a node's actuators from 0), non-finite, zero or negative lengths, strokes, speeds and
 //! accelerations or ones the wire cannot carry (stroke ≤ 655.34 mm, speed ≤ 655.35 mm/s,
 //! acceleration ≤ 6553.5 mm/s²), angles outside [0, 360), asymmetric or conflicting mirror
-//! pairs and actuators off the centre line without a partner. Ids may use letters, digits,
+//! pairs, actuators off the centre line without a partner, a ring's `part` that does not
+//! match its centre and an anchor used twice or on a leg ring. Ids may use letters, digits,
 //! `-`, `_` and `.`; `node<N>` is reserved for node names in fault specs.
 //!
 //! A node reports one set of capabilities (the weakest of its actuators), and its actuators'
@@ -61,57 +71,11 @@
 //! limits (the reference form does).
 
 mod description;
+mod file;
 mod validate;
 
-pub use description::{ActuatorSpec, FormDescription, NodeSpec, RingSpec};
+pub use description::{
+    ActuatorSpec, Anchor, BodyPart, FormDescription, FormSpec, NodeSpec, RingSpec,
+};
+pub use file::{FormError, REFERENCE_TOML, reference};
 pub use validate::Problem;
-
-use std::path::PathBuf;
-
-/// The reference form's description, as shipped in `sim/forms/reference.toml`.
-pub const REFERENCE_TOML: &str = include_str!("../../forms/reference.toml");
-
-/// The shipped reference form: 64 actuators on 8 nodes from neck to mid-thigh (see
-/// `sim/README.md` for its layout).
-pub fn reference() -> FormDescription {
-    // The file is part of the crate and a test checks it validates.
-    FormDescription::from_toml_str(REFERENCE_TOML)
-        .unwrap_or_else(|error| unreachable!("the shipped reference form is invalid: {error}"))
-}
-
-/// Why a form description could not be used.
-#[derive(Debug, thiserror::Error)]
-pub enum FormError {
-    /// The file could not be read.
-    #[error("cannot read form description {}: {source}", path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// Not TOML, or not the shape of a form description (the message names the field).
-    #[error("{}{source}", origin(path))]
-    Toml {
-        /// The file, if read from one.
-        path: Option<PathBuf>,
-        /// The parser's error, with line, column and field.
-        source: toml::de::Error,
-    },
-    /// Well-formed but inconsistent: every problem found.
-    #[error("{}invalid form description:{}", origin(path), list(problems))]
-    Invalid {
-        /// The file, if read from one.
-        path: Option<PathBuf>,
-        /// Every problem, in file order.
-        problems: Vec<Problem>,
-    },
-}
-
-fn origin(path: &Option<PathBuf>) -> String {
-    path.as_ref().map(|p| format!("{}: ", p.display())).unwrap_or_default()
-}
-
-fn list(problems: &[Problem]) -> String {
-    problems.iter().map(|p| format!("\n  - {p}")).collect()
-}
