@@ -37,11 +37,10 @@ fn makehuman_mannequin_keeps_girths_and_surface() {
                 row.tape_change_mm
             );
         }
-        // Every torso layer keeps its section's girth, except above the shoulder points, where
-        // the shoulders are eased into a dress form's slope (tests/mannequin_quality.rs).
+        // Every torso layer keeps its section's girth (above the arm plates the mesh's rings
+        // bend over the shoulders, but the layers stay horizontal).
         let lm = &m.landmarks;
-        let shoulders = lm.left_armhole.shoulder_point.z.min(lm.right_armhole.shoulder_point.z);
-        for layer in m.torso.iter().filter(|l| l.z < shoulders) {
+        for layer in &m.torso {
             let (kept, asked) = match preserve {
                 Preserve::Tape => (layer.tape_girth, layer.input_tape_girth),
                 Preserve::Contour => (layer.contour_length, layer.input_contour_length),

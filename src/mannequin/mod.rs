@@ -4,15 +4,16 @@
 //! Layers (defaults from the paper): 100 torso layers from just above the crotch to the neck,
 //! 50 leg layers from the ankles to just below the crotch. Above the armpits the torso sections
 //! are cut at the armholes ([`crate::regions::Armhole`]), so the arms are not part of the
-//! torso: the cut edges of the layers stack into flat arm plates, and above the shoulder points
-//! the layers follow the shoulders with their slope, eased where the body's shoulder top is
-//! nearly level ([`shoulders`]). The legs' top layers are eased into the hips above them
-//! ([`thighs`]), so the crotch join has no step. All layers share one symmetry plane, x = `axis`: the median of
-//! the torso sections' bounding-box centres.
+//! torso: the cut edges stack into flat arm plates. Every torso layer is horizontal and keeps
+//! its section's girth; above the arm plates the mesh is built from rings bent up over the
+//! shoulders, which follow the shoulder top with its own slope ([`shoulder_cap`]). The legs'
+//! top layers are eased into the hips above them ([`thighs`]), so the crotch join has no step.
+//! All layers share one symmetry plane, x = `axis`: the median of the torso sections'
+//! bounding-box centres.
 
 mod layers;
 mod rebuild;
-mod shoulders;
+mod shoulder_cap;
 mod thighs;
 
 use crate::mesh::Mesh;
@@ -81,6 +82,9 @@ pub struct Mannequin {
     pub left_leg: Vec<Layer>,
     /// Right-leg layers, bottom to top.
     pub right_leg: Vec<Layer>,
+    /// The height from which the mesh's torso rings bend up over the shoulders (see
+    /// [`shoulder_cap`]); below it they are the torso layers.
+    pub shoulder_cap_from: f64,
     /// The watertight, consistently oriented mannequin mesh.
     pub mesh: Mesh,
 }
@@ -159,16 +163,24 @@ pub fn build(
         });
     }
     crate::symmetry::check_rays(options.rays)?;
-    let layers::SymmetricLayers { axis, mut torso, mut left_leg, mut right_leg } =
+    let layers::SymmetricLayers { axis, torso, mut left_leg, mut right_leg } =
         layers::symmetric_layers(body, regions, keep, options)?;
-    let lm = &regions.landmarks;
-    shoulders::ease(
-        &mut torso,
-        axis,
-        lm.left_armhole.shoulder_point.z.min(lm.right_armhole.shoulder_point.z),
-    );
+    let cap = shoulder_cap::build(body, &regions.landmarks, &torso, axis, options)?;
     thighs::ease(&torso[0], &mut left_leg, &mut right_leg);
-    let mesh = rebuild::rebuild(&torso, &left_leg, &right_leg, axis, regions.landmarks.crotch);
+    let rings: Vec<Vec<DVec3>> = torso
+        .iter()
+        .take_while(|layer| layer.z < cap.from)
+        .map(|layer| layer.points.iter().map(|p| p.extend(layer.z)).collect())
+        .chain(cap.rings)
+        .collect();
+    let mesh = rebuild::rebuild(
+        &rings,
+        cap.neck_centre,
+        &left_leg,
+        &right_leg,
+        axis,
+        regions.landmarks.crotch,
+    );
     Ok(Mannequin {
         axis,
         landmarks: regions.landmarks,
@@ -176,6 +188,7 @@ pub fn build(
         torso,
         left_leg,
         right_leg,
+        shoulder_cap_from: cap.from,
         mesh,
     })
 }

@@ -96,7 +96,7 @@ fn cap(mesh: &mut Mesh, ring: &[u32], centre: DVec3, up: bool) {
 /// A torso ring with its front and back vertices on the symmetry plane inserted: the front
 /// one first, then the left half (front to back), the back one, the right half (back to front).
 /// Returns the ring and the index of the back vertex.
-fn with_midline(points: &[DVec2]) -> (Vec<DVec2>, usize) {
+fn with_midline(points: &[DVec3]) -> (Vec<DVec3>, usize) {
     let n = points.len(); // rays - 2
     let half = n / 2; // points per side
     let front = (points[n - 1] + points[0]) * 0.5;
@@ -242,10 +242,12 @@ fn crotch(
     join_leg(mesh, right_top, right);
 }
 
-/// The mannequin mesh from its layers (each list bottom to top), its symmetry plane and the
-/// crotch height.
+/// The mannequin mesh from its torso rings (bottom to top, each `rays - 2` points as a torso
+/// layer's, see [`super::shoulder_cap`]) closed by the neck cap around `neck_centre`, its leg
+/// layers (each list bottom to top), its symmetry plane and the crotch height.
 pub(super) fn rebuild(
-    torso: &[Layer],
+    torso: &[Vec<DVec3>],
+    neck_centre: DVec3,
     left: &[Layer],
     right: &[Layer],
     axis: f64,
@@ -255,19 +257,20 @@ pub(super) fn rebuild(
 
     let mut torso_rings = Vec::with_capacity(torso.len());
     let mut back = 0;
-    for layer in torso {
-        let (points, b) = with_midline(&layer.points);
+    for ring in torso {
+        let (points, b) = with_midline(ring);
         back = b;
-        torso_rings.push(Ring::evenly(add_ring(&mut mesh, &points, layer.z)));
+        let first = mesh.positions.len() as u32;
+        mesh.positions.extend(points);
+        torso_rings.push(Ring::evenly((first..mesh.positions.len() as u32).collect()));
     }
     for pair in torso_rings.windows(2) {
         stitch(&mut mesh, &pair[0], &pair[1]);
     }
-    let top = torso.last().expect("at least two torso layers");
     cap(
         &mut mesh,
-        &torso_rings.last().expect("rings").vertices,
-        DVec3::new(axis, top.centre[1], top.z),
+        &torso_rings.last().expect("at least two torso rings").vertices,
+        neck_centre,
         true,
     );
 

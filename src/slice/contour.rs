@@ -82,6 +82,12 @@ impl Contour {
         Contour { points: clip_half_plane(&self.points, |p| offset - normal.dot(p)) }
     }
 
+    /// The part of the loop where `side(p) >= 0`, for a `side` linear along each edge (or
+    /// nearly so: crossings are interpolated linearly); the cuts become straight edges.
+    pub fn keep_where(&self, side: impl Fn(DVec2) -> f64) -> Contour {
+        Contour { points: clip_half_plane(&self.points, side) }
+    }
+
     /// Whether `p` lies inside the loop (even-odd rule).
     pub fn contains(&self, p: DVec2) -> bool {
         let mut inside = false;

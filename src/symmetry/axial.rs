@@ -15,7 +15,8 @@ pub struct AxialRing {
 }
 
 /// Makes `section` symmetric with `n` rays:
-/// - eq. 5: the centre is the section's bounding-box centre; the section is moved sideways so
+/// - eq. 5: the centre is the section's bounding-box centre (moved inside the section along
+///   the vertical line through it where it lies outside, [`rays::ray_origin`]); the section is moved sideways so
 ///   that the centre lies on the body's symmetry plane x = `axis` (one plane for the whole
 ///   mannequin, so that it is mirror-symmetric as a whole);
 /// - eq. 6: ray `i` meets the contour at distance `r_i` (farthest crossing);
@@ -31,7 +32,7 @@ pub fn symmetrize(
     if section.points.len() < 3 {
         return Err(SymmetryError::EmptySection(f64::NAN));
     }
-    let c = rays::bbox_centre(section);
+    let c = rays::ray_origin(section);
     let r = rays::cast(section, c, n);
     let centre = DVec2::new(axis, c.y);
     let mut points: Vec<DVec2> = (1..n)

@@ -60,9 +60,71 @@ pub fn bbox_centre(contour: &Contour) -> DVec2 {
     (lo + hi) * 0.5
 }
 
+/// The rays' origin for `contour`: its bounding-box centre (eq. 5), or, where that lies
+/// outside the contour, the middle of the longest stretch of the vertical line through it
+/// (x unchanged, so the section still moves onto the symmetry plane by its bounding box) that
+/// lies inside. A loop just formed above the crotch wraps around the gluteal cleft, which
+/// holds its bounding-box centre: from there the rays towards the back miss the loop, and each
+/// would take the loop's extent, a flap behind the buttocks.
+pub fn ray_origin(contour: &Contour) -> DVec2 {
+    let c = bbox_centre(contour);
+    if contour.contains(c) {
+        return c;
+    }
+    let pts = &contour.points;
+    let mut ys: Vec<f64> = (0..pts.len())
+        .filter_map(|k| {
+            let (a, b) = (pts[k], pts[(k + 1) % pts.len()]);
+            ((a.x > c.x) != (b.x > c.x)).then(|| a.y + (b.y - a.y) * (c.x - a.x) / (b.x - a.x))
+        })
+        .collect();
+    ys.sort_by(f64::total_cmp);
+    let longest = ys.chunks_exact(2).max_by(|p, q| (p[1] - p[0]).total_cmp(&(q[1] - q[0])));
+    longest.map_or(c, |p| DVec2::new(c.x, 0.5 * (p[0] + p[1])))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rays_start_inside_a_loop_that_wraps_around_its_bounding_box_centre() {
+        // A "U" open to the back (+Y), as just above the crotch: the bbox centre (0, 0) lies
+        // in the notch; the origin moves onto the line x = 0 inside the base of the U.
+        let u = Contour {
+            points: [
+                (-3., -3.),
+                (3., -3.),
+                (3., 3.),
+                (1., 3.),
+                (1., -1.),
+                (-1., -1.),
+                (-1., 3.),
+                (-3., 3.),
+            ]
+            .iter()
+            .map(|&(x, y)| DVec2::new(x, y))
+            .collect(),
+        };
+        assert_eq!(ray_origin(&u), DVec2::new(0.0, -2.0));
+        // Every ray from the origin ends on the U; from the bbox centre some miss it.
+        let off_the_u = |origin: DVec2| {
+            let r = cast(&u, origin, 360);
+            (0..360)
+                .filter(|&i| {
+                    let p = origin + direction(i, 360) * r[i];
+                    let n = u.points.len();
+                    (0..n).all(|k| {
+                        let (a, b) = (u.points[k], u.points[(k + 1) % n]);
+                        let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+                        p.distance(a + (b - a) * t) > 1e-9
+                    })
+                })
+                .count()
+        };
+        assert_eq!(off_the_u(ray_origin(&u)), 0);
+        assert!(off_the_u(bbox_centre(&u)) > 0);
+    }
 
     #[test]
     fn directions_start_at_the_front_and_mirror_pairwise() {

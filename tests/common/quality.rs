@@ -15,14 +15,14 @@ use std::collections::HashMap;
 pub const WIDTH_JUMP_STEP_MM: f64 = 2.0;
 
 /// The largest change of left-right width between horizontal slices `WIDTH_JUMP_STEP_MM`
-/// apart, over every pair of slices that both cut the mesh: (jump in mm, height of the lower
-/// slice). A smooth body stays under 15 mm.
-pub fn width_jump(mesh: &Mesh) -> (f64, f64) {
+/// apart, over every pair of slices that both cut the mesh between heights `lo` and `hi`:
+/// (jump in mm, height of the lower slice). A smooth body stays under 15 mm.
+pub fn width_jump(mesh: &Mesh, lo: f64, hi: f64) -> (f64, f64) {
     let b = mesh.bounds().expect("a mesh");
-    let n = ((b.size().z - WIDTH_JUMP_STEP_MM) / WIDTH_JUMP_STEP_MM).floor() as usize;
-    let heights: Vec<f64> = (0..=n)
-        .map(|k| b.min.z + 0.5 * WIDTH_JUMP_STEP_MM + k as f64 * WIDTH_JUMP_STEP_MM)
-        .collect();
+    let (lo, hi) = (lo.max(b.min.z), hi.min(b.max.z));
+    let n = ((hi - lo - WIDTH_JUMP_STEP_MM) / WIDTH_JUMP_STEP_MM).floor().max(0.0) as usize;
+    let heights: Vec<f64> =
+        (0..=n).map(|k| lo + 0.5 * WIDTH_JUMP_STEP_MM + k as f64 * WIDTH_JUMP_STEP_MM).collect();
     let widths: Vec<(f64, Option<f64>)> = sections(mesh, &heights)
         .iter()
         .map(|s| {
@@ -271,4 +271,64 @@ pub fn largest_crease(mesh: &Mesh, counts: impl Fn([DVec3; 3], [DVec3; 3]) -> bo
             _ => None,
         })
         .fold(0.0, f64::max)
+}
+
+/// A vertex lies on a plate within this distance of its plane (mm).
+const ON_PLATE_MM: f64 = 1e-3;
+
+/// The total turning (degrees) of the rim of the flat region of `mesh` in the plane through
+/// `point` with unit normal `normal`: the longest boundary loop of the faces whose corners all
+/// lie within [`ON_PLATE_MM`] of the plane, with the loop's vertex count (`None` where no face
+/// lies on it). A convex curve turns 360 degrees in all; each step of a staircase adds about
+/// 180.
+pub fn plate_rim_turning(mesh: &Mesh, point: DVec3, normal: DVec3) -> Option<(f64, usize)> {
+    let on = |v: u32| (mesh.positions[v as usize] - point).dot(normal).abs() <= ON_PLATE_MM;
+    let mut uses: HashMap<(u32, u32), usize> = HashMap::new();
+    for tri in mesh.triangles.iter().filter(|tri| tri.iter().all(|&v| on(v))) {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let mut next: HashMap<u32, Vec<u32>> = HashMap::new();
+    for (&(a, b), _) in uses.iter().filter(|(_, n)| **n == 1) {
+        next.entry(a).or_default().push(b);
+        next.entry(b).or_default().push(a);
+    }
+    // Walk the boundary loops; keep the longest.
+    let mut seen = std::collections::HashSet::new();
+    let mut longest: Vec<u32> = Vec::new();
+    for &start in next.keys() {
+        if !seen.insert(start) {
+            continue;
+        }
+        let (mut path, mut previous, mut at) = (vec![start], start, next[&start][0]);
+        while at != start && seen.insert(at) {
+            path.push(at);
+            let step = next[&at].iter().copied().find(|&v| v != previous).unwrap_or(previous);
+            (previous, at) = (at, step);
+        }
+        if path.len() > longest.len() {
+            longest = path;
+        }
+    }
+    if longest.len() < 3 {
+        return None;
+    }
+    let (u, v) = normal.any_orthonormal_pair();
+    let flat: Vec<glam::DVec2> = longest
+        .iter()
+        .map(|&k| {
+            let p = mesh.positions[k as usize] - point;
+            glam::DVec2::new(p.dot(u), p.dot(v))
+        })
+        .collect();
+    let n = flat.len();
+    let turning: f64 = (0..n)
+        .map(|k| {
+            let (a, b) = (flat[k] - flat[(k + n - 1) % n], flat[(k + 1) % n] - flat[k]);
+            a.perp_dot(b).atan2(a.dot(b)).abs()
+        })
+        .sum();
+    Some((turning.to_degrees(), n))
 }
