@@ -17,7 +17,6 @@ use dressform::mesh::{Mesh, smooth::DEFAULT_PASSES};
 use dressform::pipeline::{Symmetrized, symmetrize};
 use dressform::regions::Region;
 use dressform::scan::{self, Scan, format::Format, frame::FrameOptions};
-use dressform::symmetry::rays::bbox_centre;
 use glam::DVec3;
 use rayon::prelude::*;
 use sim::capture::{Artifacts, BodyParams, Pose, SyntheticBody, capture, generate};
@@ -228,7 +227,7 @@ fn report(case: &Case, out: &Symmetrized) -> Report {
         let centres: Vec<(f64, f64)> = leg_heights
             .iter()
             .zip(&sections)
-            .map(|(&z, c)| (z, bbox_centre(c.as_ref().expect("a leg section")).x))
+            .map(|(&z, c)| (z, c.as_ref().expect("a leg section").bbox_centre().x))
             .collect();
         abduction_deg(&centres)
     };

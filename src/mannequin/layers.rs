@@ -4,7 +4,7 @@ use super::{Layer, MannequinError, MannequinOptions};
 use crate::mesh::Mesh;
 use crate::regions::{BodyRegions, Region, largest_with};
 use crate::slice::{Contour, sections};
-use crate::symmetry::{axial, bilateral, rays};
+use crate::symmetry::{axial, bilateral};
 use glam::DVec2;
 
 /// How far inside the crotch the first torso and last leg layers stay (mm): exactly at the
@@ -67,8 +67,7 @@ pub(super) fn symmetric_layers(
             c.map(|c| (z, c)).ok_or(MannequinError::MissingLoop { region: Region::Torso, z })
         })
         .collect::<Result<_, _>>()?;
-    let mut centres: Vec<f64> =
-        torso_sections.iter().map(|(_, c)| rays::bbox_centre(c).x).collect();
+    let mut centres: Vec<f64> = torso_sections.iter().map(|(_, c)| c.bbox_centre().x).collect();
     centres.sort_by(f64::total_cmp);
     let axis = centres[centres.len() / 2];
 

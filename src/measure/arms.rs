@@ -12,7 +12,6 @@
 //! (the projection read wrists 6-13 mm short on the generator's customers). An arm raised
 //! close to horizontal has no such loops: its measurements are absent.
 
-use super::dimensions::Bilateral;
 use super::plane::PlaneLoop;
 use crate::mesh::Mesh;
 use crate::regions::{BodyRegions, Region};
@@ -74,15 +73,6 @@ pub fn arms(body: &Mesh, regions: &BodyRegions) -> [Option<ArmMeasures>; 2] {
             measure_arm(body, &loops, armhole.shoulder_point, m.height)
         },
     )
-}
-
-/// One measurement of both arms, NaN (null in JSON) for an arm not measured.
-pub(super) fn bilateral(
-    arms: &[Option<ArmMeasures>; 2],
-    pick: impl Fn(&ArmMeasures) -> f64,
-) -> Bilateral {
-    let side = |a: &Option<ArmMeasures>| a.as_ref().map_or(f64::NAN, &pick);
-    Bilateral::new(side(&arms[0]), side(&arms[1]))
 }
 
 /// The arm's loops from just below its armpit down to its end, with their heights.

@@ -3,7 +3,7 @@
 //! the regions. Each rule is stated on its field and in the README, so that a tailor can
 //! check it with a tape; lengths in millimetres, angles in degrees, heights above the floor.
 
-use super::arms::{arms, bilateral};
+use super::arms::{ArmMeasures, arms};
 use super::neck_and_shoulders::{midline_profile, neck_and_shoulders};
 use super::{Girth, Levels, deepest_fold, forward};
 use crate::mesh::Mesh;
@@ -115,7 +115,7 @@ pub const KNEE_OF_CROTCH: f64 = 0.6;
 /// How far below the chest the underbust is looked for, as a fraction of the stature.
 const UNDERBUST_SPAN: f64 = 0.10;
 /// The least depth of a fold under the bust (mm): the typical scanner's noise (sigma 1 mm,
-/// `sim::capture::Artifacts::typical_scanner`) leaves no dent this deep after smoothing; the
+/// the generator's `capture::Artifacts::typical_scanner`) leaves no dent this deep after smoothing; the
 /// MakeHuman base body's fold is 3 mm deep.
 const MIN_FOLD_MM: f64 = 1.0;
 /// Spacing of the levels searched and of the midline profiles (mm).
@@ -135,6 +135,12 @@ fn tape(c: &Option<Contour>) -> f64 {
 fn midline_length(body: &Mesh, regions: &BodyRegions, from: f64, to: f64, front: bool) -> f64 {
     let profile = midline_profile(body, regions, from, to, front);
     profile.windows(2).map(|w| w[0].distance(w[1])).sum()
+}
+
+/// One measurement of both arms, NaN (null in JSON) for an arm not measured.
+fn bilateral(arms: &[Option<ArmMeasures>; 2], pick: impl Fn(&ArmMeasures) -> f64) -> Bilateral {
+    let side = |a: &Option<ArmMeasures>| a.as_ref().map_or(f64::NAN, &pick);
+    Bilateral::new(side(&arms[0]), side(&arms[1]))
 }
 
 /// The tape girth of the left and right leg at each of `zs`: per height (left, right).

@@ -35,7 +35,7 @@ pub fn symmetrize(
     if left.points.len() < 3 || right.points.len() < 3 {
         return Err(SymmetryError::EmptySection(f64::NAN));
     }
-    let (cl, cr) = (rays::bbox_centre(left), rays::bbox_centre(right));
+    let (cl, cr) = (left.bbox_centre(), right.bbox_centre());
     let (rl, rr) = (rays::cast(left, cl, n), rays::cast(right, cr, n));
     let offset = 0.5 * ((cl.x - axis) + (axis - cr.x));
     let depth = 0.5 * (cl.y + cr.y);

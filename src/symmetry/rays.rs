@@ -49,17 +49,6 @@ pub fn cast_along(contour: &Contour, centre: DVec2, directions: &[DVec2]) -> Vec
         .collect()
 }
 
-/// Centre of a contour's bounding box (paper eq. 5 and eq. 9).
-pub fn bbox_centre(contour: &Contour) -> DVec2 {
-    let (lo, hi) = contour
-        .points
-        .iter()
-        .fold((DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
-            (lo.min(*p), hi.max(*p))
-        });
-    (lo + hi) * 0.5
-}
-
 /// The rays' origin for `contour`: its bounding-box centre (eq. 5), or, where that lies
 /// outside the contour, the middle of the longest stretch of the vertical line through it
 /// (x unchanged, so the section still moves onto the symmetry plane by its bounding box) that
@@ -67,7 +56,7 @@ pub fn bbox_centre(contour: &Contour) -> DVec2 {
 /// holds its bounding-box centre: from there the rays towards the back miss the loop, and each
 /// would take the loop's extent, a flap behind the buttocks.
 pub fn ray_origin(contour: &Contour) -> DVec2 {
-    let c = bbox_centre(contour);
+    let c = contour.bbox_centre();
     if contour.contains(c) {
         return c;
     }
@@ -123,7 +112,7 @@ mod tests {
                 .count()
         };
         assert_eq!(off_the_u(ray_origin(&u)), 0);
-        assert!(off_the_u(bbox_centre(&u)) > 0);
+        assert!(off_the_u(u.bbox_centre()) > 0);
     }
 
     #[test]
