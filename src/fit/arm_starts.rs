@@ -1,7 +1,8 @@
 //! Several starts for the arms: landmark-free fits are known to settle with an arm matched to
 //! the torso beside it. Before the limbs are freed, each upper arm tries a range of
-//! abductions about the rest frame's front-to-back axis and keeps the one whose pairs cost the
-//! least (eq. 4's data term, freshly matched).
+//! abductions about the rest frame's front-to-back axis and keeps the one that lies closest to
+//! the scan both ways ([`correspondences::robust_distance`]: an arm far from the scan, or a
+//! part of the scan no arm covers, is charged in full).
 
 use super::correspondences::{self, ScanCloud};
 use super::params::{Params, Prepared, vertex_normals};
@@ -29,8 +30,7 @@ pub fn best(prep: &Prepared, scan: &ScanCloud, mut params: Params, sigma: f64) -
             params.theta[bone] = theta;
             let posed = prep.pose(&params);
             let normals = vertex_normals(&posed.vertices, &prep.model.triangles);
-            let data = correspondences::gather(scan, &posed.vertices, &normals, sigma);
-            let cost = data.cost(&posed.vertices);
+            let cost = correspondences::robust_distance(scan, &posed.vertices, &normals, sigma);
             if cost < best.0 {
                 best = (cost, theta);
             }

@@ -92,6 +92,51 @@ impl Quadratics {
     }
 }
 
+/// How far the posed model (`vertices` with `normals`) lies from the scan, robustly, both ways:
+/// the mean Geman-McClure cost ([`robust::cost`] at scale `sigma`) of each model vertex to its
+/// nearest scan point and of each sampled scan point to its nearest model vertex, a pair whose
+/// normals disagree (or whose scan point lies on a hole's boundary) counted as unmatched, at
+/// the full `sigma^2`; the two directions weigh alike. Unlike the quadratics of [`gather`],
+/// whose weights vanish for pairs far apart (a limb far from the scan costs almost nothing
+/// there), this charges every part of the model away from the scan, and every part of the scan
+/// the model does not cover: the measure that tells several starts apart
+/// ([`super::arm_starts`]).
+pub fn robust_distance(
+    cloud: &ScanCloud,
+    vertices: &[DVec3],
+    normals: &[DVec3],
+    sigma: f64,
+) -> f64 {
+    let scan = cloud.scan;
+    let unmatched = sigma * sigma;
+    let pair = |v: usize, s: usize| {
+        let agree = normals[v].dot(scan.normals[s]) >= MIN_NORMAL_COS;
+        if agree && !scan.on_hole_boundary[s] {
+            robust::cost(vertices[v].distance_squared(scan.points[s]), sigma)
+        } else {
+            unmatched
+        }
+    };
+    let to_scan: f64 = (0..vertices.len())
+        .into_par_iter()
+        .map(|v| {
+            let hit = cloud.tree.nearest_one::<SquaredEuclidean>(&vertices[v].to_array());
+            pair(v, hit.item as usize)
+        })
+        .sum();
+    let coords: Vec<[f64; 3]> = vertices.iter().map(|p| p.to_array()).collect();
+    let model_tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&coords);
+    let to_model: f64 = cloud
+        .samples
+        .par_iter()
+        .map(|&s| {
+            let hit = model_tree.nearest_one::<SquaredEuclidean>(&scan.points[s].to_array());
+            pair(hit.item as usize, s)
+        })
+        .sum();
+    0.5 * (to_scan / vertices.len().max(1) as f64 + to_model / cloud.samples.len().max(1) as f64)
+}
+
 /// One pair: model vertex, scan point, the normal of its plane, its robust weight.
 struct Pair {
     vertex: usize,
