@@ -139,6 +139,17 @@ impl Position {
     }
 }
 
+/// `x` rounded to the nearest whole number (halves up) if that fits a `u16` wire value. By
+/// hand because `f64::round` needs `std` (or libm), and this crate builds for `no_std`
+/// targets: for `x` in -0.5..65535.5, adding a half and truncating is rounding.
+fn round_to_wire(x: f64) -> Option<u16> {
+    // The negated comparison also rejects NaN.
+    if !(-0.5..f64::from(u16::MAX) + 0.5).contains(&x) {
+        return None;
+    }
+    Some((x + 0.5) as u16)
+}
+
 /// A speed (limit), in the wire's unit of **0.01 mm/s**: 0..=655.35 mm/s.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Speed(u16);
@@ -151,12 +162,7 @@ impl Speed {
 
     /// The speed rounded to 0.01 mm/s, if `mm_s` is a number in 0..=655.35.
     pub fn from_mm_s(mm_s: f64) -> Option<Self> {
-        let hundredths = (mm_s * 100.0).round();
-        // The negated comparison also rejects NaN.
-        if !(0.0..=f64::from(u16::MAX)).contains(&hundredths) {
-            return None;
-        }
-        Some(Self(hundredths as u16))
+        round_to_wire(mm_s * 100.0).map(Self)
     }
 
     /// The speed in 0.01 mm/s (the wire value).
@@ -183,11 +189,7 @@ impl Accel {
 
     /// The acceleration rounded to 0.1 mm/s², if `mm_s2` is a number in 0..=6553.5.
     pub fn from_mm_s2(mm_s2: f64) -> Option<Self> {
-        let tenths = (mm_s2 * 10.0).round();
-        if !(0.0..=f64::from(u16::MAX)).contains(&tenths) {
-            return None;
-        }
-        Some(Self(tenths as u16))
+        round_to_wire(mm_s2 * 10.0).map(Self)
     }
 
     /// The acceleration in 0.1 mm/s² (the wire value).
