@@ -5,6 +5,7 @@
 //! joint-to-joint direction in the frontal (XZ) plane.
 
 use crate::common;
+use common::frontal::{abduction, elevation};
 use dressform::body_model::BodyModel;
 use dressform::fit::{self, FitOptions};
 use dressform::makehuman::{MakeHuman, Pose};
@@ -39,19 +40,6 @@ const MEASURES: [&str; 4] = [
     "measure/measure-bust-circ-incr",
     "measure/measure-upperarm-circ-incr",
 ];
-
-/// A limb's angle from straight down in the frontal plane (degrees, outwards positive on
-/// both sides), from its upper joint to its lower one.
-fn abduction(upper: DVec3, lower: DVec3) -> f64 {
-    let d = lower - upper;
-    d.x.abs().atan2(-d.z).to_degrees()
-}
-
-/// The clavicle's elevation: its direction's angle above the horizontal in the frontal plane.
-fn elevation(inner: DVec3, outer: DVec3) -> f64 {
-    let d = outer - inner;
-    d.z.atan2(d.x.abs()).to_degrees()
-}
 
 /// Points with normals sampled uniformly on `mesh`'s surface, with noise and holes.
 fn scan_of(mesh: &Mesh, rng: &mut ChaCha8Rng) -> (Vec<DVec3>, Vec<DVec3>) {

@@ -8,6 +8,7 @@
 //! Then the same for a different deformer: the sim generator's capsule-limbed bodies.
 
 use crate::common;
+use common::frontal::{abduction, elevation};
 use dressform::body_model::BodyModel;
 use dressform::makehuman::{MakeHuman, Pose};
 use dressform::measure::{central_loops, levels};
@@ -194,18 +195,6 @@ fn cases() -> Vec<Case> {
 fn posed(mh: &MakeHuman, body: &[DVec3], bones: &[(String, DVec3)]) -> Mesh {
     let pose = bones.iter().fold(Pose::rest(), |p, (b, t)| p.rotate(b, *t));
     mh.base.skin(&mh.pose(body, &pose).unwrap())
-}
-
-/// A limb's angle from straight down in the frontal plane (degrees, outwards positive).
-fn abduction(upper: DVec3, lower: DVec3) -> f64 {
-    let d = lower - upper;
-    d.x.abs().atan2(-d.z).to_degrees()
-}
-
-/// The clavicle's elevation above the horizontal in the frontal plane (degrees).
-fn elevation(inner: DVec3, outer: DVec3) -> f64 {
-    let d = outer - inner;
-    d.z.atan2(d.x.abs()).to_degrees()
 }
 
 /// Arm, clavicle and leg angles per side (L then R) of joints `at(name)` seen in `frame`.

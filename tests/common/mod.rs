@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+pub mod frontal;
 pub mod quality;
 mod skip;
 
