@@ -5,7 +5,7 @@
 
 use super::arms::{ArmMeasures, arms};
 use super::neck_and_shoulders::{midline_profile, neck_and_shoulders};
-use super::{Girth, Levels, deepest_fold, forward};
+use super::{Girth, Levels, deepest_fold, forward, heights_between as heights};
 use crate::mesh::Mesh;
 use crate::regions::{BodyRegions, Region};
 use crate::slice::Contour;
@@ -118,14 +118,6 @@ const UNDERBUST_SPAN: f64 = 0.10;
 /// the generator's `capture::Artifacts::typical_scanner`) leaves no dent this deep after smoothing; the
 /// MakeHuman base body's fold is 3 mm deep.
 const MIN_FOLD_MM: f64 = 1.0;
-/// Spacing of the levels searched and of the midline profiles (mm).
-const STEP_MM: f64 = 2.0;
-
-/// `count` heights from `lo` to `hi` inclusive.
-fn heights(lo: f64, hi: f64) -> Vec<f64> {
-    let count = (((hi - lo).abs() / STEP_MM) as usize).max(1) + 1;
-    (0..count).map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64).collect()
-}
 
 fn tape(c: &Option<Contour>) -> f64 {
     c.as_ref().map_or(0.0, Contour::tape_girth)

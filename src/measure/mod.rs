@@ -64,6 +64,13 @@ pub const BUST_FOLD_MM: f64 = 5.0;
 /// 0.720 H; MakeHuman's bodies have their bust points at 0.71-0.72 H).
 pub const BUST_POINT_OF_STATURE: f64 = 0.72;
 
+/// Heights from `lo` to `hi` inclusive, evenly spaced, [`LEVEL_STEP_MM`] apart or closer: the
+/// levels a rule searches or a profile joins.
+fn heights_between(lo: f64, hi: f64) -> Vec<f64> {
+    let count = (((hi - lo).abs() / LEVEL_STEP_MM) as usize).max(1) + 1;
+    (0..count).map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64).collect()
+}
+
 /// A horizontal girth.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Girth {

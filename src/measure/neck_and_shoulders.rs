@@ -22,6 +22,7 @@
 //!   only as the hollows of the arm's junction, which an arm held out or resting on the torso
 //!   changes, while the plates stay put.
 
+use super::heights_between as heights;
 use super::plane::{PlaneLoop, tape_arc};
 use crate::mesh::Mesh;
 use crate::regions::{Armhole, BodyRegions};
@@ -29,8 +30,6 @@ use crate::slice::Contour;
 use glam::{DVec2, DVec3};
 use serde::Serialize;
 
-/// Spacing of the levels of the profiles the landmarks are found on (mm).
-const STEP_MM: f64 = 2.0;
 /// Half-width of the band around the centre line whose front-most point the front profile
 /// follows (mm): as wide as the jugular notch, narrower than the neck.
 pub const MIDLINE_BAND_MM: f64 = 15.0;
@@ -75,12 +74,6 @@ pub struct NeckAndShoulders {
     /// Across front (mm; NaN where a fold is missing).
     #[serde(rename = "across_front_mm")]
     pub across_front: f64,
-}
-
-/// `count` heights from `lo` to `hi` inclusive, [`STEP_MM`] apart or closer.
-fn heights(lo: f64, hi: f64) -> Vec<f64> {
-    let count = (((hi - lo).abs() / STEP_MM) as usize).max(1) + 1;
-    (0..count).map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64).collect()
 }
 
 /// The point of `profile` farthest from the chord between its ends on the `inside` side: the
