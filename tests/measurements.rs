@@ -11,8 +11,8 @@ use crate::common;
 
 use common::{dressform, mesh_of};
 use dressform::measure::{
-    ArmMeasures, BodyDimensions, NeckAndShoulders, across_back_and_front, arms, dimensions, levels,
-    neck_and_shoulders, tape_arc, underbust,
+    ArmMeasures, BodyDimensions, NeckAndShoulders, across_back_and_front, arms, dimensions,
+    find_levels, levels, neck_and_shoulders, tape_arc, underbust,
 };
 use dressform::output::write_atomically;
 use dressform::regions::Landmarks;
@@ -341,6 +341,28 @@ fn several_scans_measure_in_parallel_as_csv_and_json() {
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("broken.ply"), "{stderr}");
     assert_eq!(stdout.lines().count(), 2, "the good scan is still measured: {stdout}");
+}
+
+/// A level its rule cannot find on the body is reported, not passed off as found: a barrel
+/// torso (waist wider than chest and hip) has no narrowest level inside the waist's band, so
+/// the waist falls back to its proportion with a note; the same body with a waist has none.
+#[test]
+fn a_level_taken_from_a_proportion_is_reported() {
+    let shaped = BodyParams::default();
+    let barrel = BodyParams { waist_girth_mm: 1.12 * shaped.chest_girth_mm, ..shaped.clone() };
+    assert!(barrel.waist_girth_mm > barrel.hip_girth_mm, "a barrel: {barrel:?}");
+    let notes = |p: &BodyParams| {
+        let mesh = mesh_of(&generate(p).unwrap());
+        let regions = BodyRegions::find(&mesh, TRACKING_STEP_MM).unwrap();
+        find_levels(&mesh, &regions).fallbacks
+    };
+    let (with_waist, without) = (notes(&shaped), notes(&barrel));
+    println!("shaped: {with_waist:?}\nbarrel: {without:?}");
+    assert!(with_waist.is_empty(), "{with_waist:?}");
+    assert!(
+        without.iter().any(|n| n.contains("waist level was not found")),
+        "no note for the barrel's waist: {without:?}"
+    );
 }
 
 /// The MakeHuman base body's chest level lies at its armpits, above the bust, where the front

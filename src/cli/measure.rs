@@ -3,7 +3,7 @@
 
 use super::{Failure, FrameArgs, SmoothArgs, warn};
 use dressform::measure::{
-    BodyDimensions, Girth, Levels, Measurements, dimensions, levels, measure_at, warnings,
+    BodyDimensions, Girth, Levels, Measurements, dimensions, find_levels, measure_at, warnings,
 };
 use dressform::regions::{BodyRegions, Landmarks, TRACKING_STEP_MM};
 use dressform::scan;
@@ -77,21 +77,22 @@ fn measure_one(path: &Path, args: &MeasureArgs) -> Result<MeasureOut, Failure> {
     for w in scan.cleaning.warnings() {
         warn(&file, &w);
     }
-    let (regions, levels) = match scan.carried {
+    let (regions, levels, fallbacks) = match scan.carried {
         // A mannequin dressform made: measured as it is (it has no scanner noise to smooth
         // away), at the levels and with the landmarks its file carries.
-        Some(carried) => (BodyRegions::armless(carried.landmarks), carried.levels),
+        Some(carried) => (BodyRegions::armless(carried.landmarks), carried.levels, Vec::new()),
         None => {
             scan.body.taubin_smooth(args.smooth.smooth);
             let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM)
                 .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
-            let levels = levels(&scan.body, &regions);
-            (regions, levels)
+            let found = find_levels(&scan.body, &regions);
+            (regions, found.levels, found.fallbacks)
         }
     };
     let measurements = measure_at(&scan.body, &regions, &levels);
     let dimensions = dimensions(&scan.body, &regions, &levels);
-    let warnings = warnings(&scan.body, &levels);
+    let mut warnings = warnings(&scan.body, &levels);
+    warnings.extend(fallbacks);
     let at = regions
         .torso_sections(&scan.body, &args.at)
         .into_iter()

@@ -60,6 +60,21 @@ const BUST_SPAN: f64 = 0.10;
 /// well above a scanner's noise after smoothing and the 1-5 mm fold of MakeHuman's flat and
 /// male chests, whose most forward level wanders by a centimetre with a slight pose.
 pub const BUST_FOLD_MM: f64 = 5.0;
+/// The hip is looked for from the crotch up this fraction of the way to the lower armpit: the
+/// seat (the buttocks' most prominent level) lies in the torso's lowest third, below the
+/// waist at about half way.
+const HIP_BAND: f64 = 0.35;
+/// Where the hip is taken when no torso loop lies in its band, as a fraction of the way from
+/// the crotch to the lower armpit: low in the band, where a seat lies.
+const HIP_FALLBACK: f64 = 0.15;
+/// The waist is looked for between these fractions of the way from the hip level to the
+/// chest level: clear of the hip's flare below and the rib cage above.
+const WAIST_BAND: (f64, f64) = (0.3, 0.8);
+/// Where the waist is taken when the torso has no narrowest level inside its band, as a
+/// fraction of the way from the hip to the chest: the natural waist lies at the elbow's level
+/// with the arms hanging (0.630 H, Drillis and Contini), about half way between their hip
+/// joint (0.530 H) and chest (0.720 H) levels.
+const WAIST_FALLBACK: f64 = 0.55;
 /// The nipple line as a fraction of the stature (Drillis and Contini's segment proportions,
 /// 0.720 H; MakeHuman's bodies have their bust points at 0.71-0.72 H).
 pub const BUST_POINT_OF_STATURE: f64 = 0.72;
@@ -122,8 +137,24 @@ pub struct Measurements {
     pub hip: Girth,
 }
 
+/// A body's measurement levels, with a note for each level its rule could not find on the
+/// body and took from the body's proportions instead.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FoundLevels {
+    /// The levels.
+    pub levels: Levels,
+    /// One line per level that fell back to a proportion, saying which and why.
+    pub fallbacks: Vec<String>,
+}
+
 /// Finds the chest, waist and hip levels (see the module documentation for the rules).
 pub fn levels(body: &Mesh, regions: &BodyRegions) -> Levels {
+    find_levels(body, regions).levels
+}
+
+/// [`levels`], with a note for each level that fell back to a proportion of the body.
+pub fn find_levels(body: &Mesh, regions: &BodyRegions) -> FoundLevels {
+    let mut fallbacks = Vec::new();
     let m = &regions.landmarks;
     // Below the lower armpit a raised arm cannot join the torso's loop.
     let armpit = m.left_armpit.min(m.right_armpit);
@@ -140,8 +171,9 @@ pub fn levels(body: &Mesh, regions: &BodyRegions) -> Levels {
             .map(|&(z, c)| (z, score(c)))
             .max_by(|a, b| a.1.total_cmp(&b.1))
     };
-    let chest = chest_level(&samples, armpit, m.height);
-    let hip_band = (m.crotch, m.crotch + 0.35 * (armpit - m.crotch));
+    let (chest, chest_note) = chest_level(&samples, armpit, m.height);
+    fallbacks.extend(chest_note);
+    let hip_band = (m.crotch, m.crotch + HIP_BAND * (armpit - m.crotch));
     let back = |c: &Contour| c.points.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max);
     let hip = match best(hip_band, &back) {
         Some((_, most)) => {
@@ -152,18 +184,38 @@ pub fn levels(body: &Mesh, regions: &BodyRegions) -> Levels {
                 .collect();
             0.5 * (seat[0] + seat[seat.len() - 1])
         }
-        None => m.crotch + 0.15 * (armpit - m.crotch),
+        None => {
+            let hip = m.crotch + HIP_FALLBACK * (armpit - m.crotch);
+            fallbacks.push(format!(
+                "the hip level was not found (no torso loop between the crotch and {:.0}% of \
+                 the way up to the armpits): it is taken at {:.0}% of the way, z = {hip:.0} mm",
+                100.0 * HIP_BAND,
+                100.0 * HIP_FALLBACK
+            ));
+            hip
+        }
     };
-    let band = (hip + 0.3 * (chest - hip), hip + 0.8 * (chest - hip));
+    let band = (hip + WAIST_BAND.0 * (chest - hip), hip + WAIST_BAND.1 * (chest - hip));
     let narrowest = best(band, &|c| -c.tape_girth()).map(|b| b.0);
     let interior = narrowest.filter(|&z| z > band.0 + LEVEL_STEP_MM && z < band.1 - LEVEL_STEP_MM);
-    let waist = interior.unwrap_or(hip + 0.55 * (chest - hip));
-    Levels { chest, waist, hip }
+    let waist = interior.unwrap_or_else(|| {
+        let waist = hip + WAIST_FALLBACK * (chest - hip);
+        fallbacks.push(format!(
+            "the waist level was not found (the torso narrows to the edge of its band, {:.0} to \
+             {:.0} mm, with no narrowest level inside): it is taken {:.0}% of the way from the \
+             hip to the chest, z = {waist:.0} mm",
+            band.0,
+            band.1,
+            100.0 * WAIST_FALLBACK
+        ));
+        waist
+    });
+    FoundLevels { levels: Levels { chest, waist, hip }, fallbacks }
 }
 
 /// The chest level among `samples` (torso loops by ascending height) below the lower `armpit`
 /// of a body `height` tall: see the module documentation.
-fn chest_level(samples: &[(f64, &Contour)], armpit: f64, height: f64) -> f64 {
+fn chest_level(samples: &[(f64, &Contour)], armpit: f64, height: f64) -> (f64, Option<String>) {
     let top = armpit - CHEST_BELOW_ARMPIT_MM;
     let band: Vec<(f64, f64)> = samples
         .iter()
@@ -174,9 +226,22 @@ fn chest_level(samples: &[(f64, &Contour)], armpit: f64, height: f64) -> f64 {
     match deepest_fold(&fronts, BUST_FOLD_MM) {
         Some((fold, _)) => {
             let above = &band[fold + 1..];
-            above.iter().max_by(|a, b| a.1.total_cmp(&b.1)).map_or(top, |b| b.0)
+            (above.iter().max_by(|a, b| a.1.total_cmp(&b.1)).map_or(top, |b| b.0), None)
         }
-        None => (BUST_POINT_OF_STATURE * height).min(top),
+        None => {
+            // No bust fold (a flat or male chest): the nipple line's proportion is the rule
+            // then, unless the armpits are so low that it lies above them.
+            let proportion = BUST_POINT_OF_STATURE * height;
+            let note = (proportion > top).then(|| {
+                format!(
+                    "the chest level was not found: no fold under a bust and the nipple line's \
+                     proportion ({BUST_POINT_OF_STATURE} of the height, z = {proportion:.0} mm) \
+                     lies above the lower armpit ({armpit:.0} mm): it is taken just below the \
+                     armpit, z = {top:.0} mm"
+                )
+            });
+            (proportion.min(top), note)
+        }
     }
 }
 

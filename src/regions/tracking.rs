@@ -157,6 +157,160 @@ fn overlaps(a: &Contour, b: &Contour) -> bool {
     a.points.iter().any(|&p| b.contains(p))
 }
 
+/// Where the torso is picked up, as a fraction of the height: between the crotch (the hip
+/// joint at 0.530 H) and the armpits (the chest at 0.720 H), Drillis and Contini.
+const TORSO_SEED_LEVEL: f64 = 0.6;
+/// The chin, as a fraction of the height (0.870 H, Drillis and Contini): the neck lies below
+/// the head's widest level above it, and no arm joins the torso above it.
+const CHIN_LEVEL: f64 = 0.87;
+/// Where the ankle (the narrowest level of the leg near the floor) is looked for, as
+/// fractions of the height: above the floor contact of the sole, up to the shins.
+const ANKLE_BAND: (f64, f64) = (0.03, SHIN_LEVEL);
+/// The ankle's height when no leg loop lies in [`ANKLE_BAND`], as a fraction of the height:
+/// the narrowest part of the shank, above the malleolus (0.039 H, Drillis and Contini).
+const ANKLE_FALLBACK: f64 = 0.08;
+
+/// The tracking levels: level `i` at `floor + step * (i + 0.5)`.
+#[derive(Debug, Clone, Copy)]
+struct Grid {
+    floor: f64,
+    step: f64,
+    height: f64,
+    count: usize,
+}
+
+impl Grid {
+    /// Height of level `i` (mm).
+    fn z(&self, i: usize) -> f64 {
+        self.floor + self.step * (i as f64 + 0.5)
+    }
+
+    /// The level at `fraction` of the body's height.
+    fn at(&self, fraction: f64) -> usize {
+        ((fraction * self.height / self.step) as usize).min(self.count - 1)
+    }
+
+    /// Whether level `i` lies between the fractions `band` of the height.
+    fn within(&self, i: usize, band: (f64, f64)) -> bool {
+        (band.0..=band.1).contains(&((self.z(i) - self.floor) / self.height))
+    }
+}
+
+/// The legs, followed from the shins: each level's left and right leg loop, the first level
+/// where they are one loop (the crotch), and their loops just below it.
+struct Legs {
+    loops: Vec<[Option<usize>; 2]>,
+    crotch_level: usize,
+    apart: [(usize, usize); 2],
+}
+
+/// The legs from their ends: the two largest loops at the shins (below any hand, above the
+/// feet), followed up until both land in one loop (the crotch: where the legs part), which
+/// must be at or below the torso's `seed` level, and down to the floor.
+fn track_legs(sections: &[Section], grid: Grid, seed: usize) -> Result<Legs, RegionError> {
+    let shin = grid.at(SHIN_LEVEL);
+    let shins = &sections[shin].loops;
+    if shins.len() < 2 {
+        return Err(RegionError::NoLegs { z: grid.z(shin), loops: shins.len() });
+    }
+    let start = if shins[0].centroid().x > shins[1].centroid().x { [0, 1] } else { [1, 0] };
+    let mut loops: Vec<[Option<usize>; 2]> = vec![[None, None]; grid.count];
+    let mut apart = start.map(|k| (shin, k));
+    let mut crotch_level = None;
+    for i in shin + 1..grid.count {
+        let found = apart.map(|(j, k)| continuing(&sections[i], &sections[j].loops[k]));
+        match found {
+            [Some(l), Some(r)] if l == r => {
+                crotch_level = Some(i);
+                break;
+            }
+            [Some(l), Some(r)] => {
+                loops[i] = [Some(l), Some(r)];
+                apart = [(i, l), (i, r)];
+            }
+            _ => break,
+        }
+    }
+    let Some(crotch_level) = crotch_level.filter(|&i| i <= seed) else {
+        return Err(RegionError::NoCrotch);
+    };
+    for (s, k) in start.into_iter().enumerate() {
+        for (i, k) in follow(sections, (0..=shin).rev(), k) {
+            loops[i][s] = Some(k);
+        }
+    }
+    Ok(Legs { loops, crotch_level, apart })
+}
+
+/// Where an arm joins the torso going up: the level `level` below the join, the torso's loop
+/// `torso` there, and how.
+#[derive(Debug, Clone, Copy)]
+struct ArmJoin {
+    level: usize,
+    torso: usize,
+    how: Join,
+}
+
+/// Where the arm on side `sign` (+1 the subject's left) joins the torso's loops `up` (from
+/// the seed upward, below the chin level `chin`): going up, the first level where the
+/// torso's loop takes in an arm on that side. A loop beside it joins it (a hanging or A-posed
+/// arm at once, a raised arm's underside as a thin sliver), or the loop reaches out at once
+/// much further than the torso's side could (an arm held out horizontally grows straight out
+/// of it, with no separate loop below).
+fn arm_join(
+    sections: &[Section],
+    up: &[(usize, usize)],
+    chin: usize,
+    sign: f64,
+) -> Option<ArmJoin> {
+    let below_chin: Vec<(usize, usize)> =
+        up.iter().take_while(|&&(i, _)| i < chin).copied().collect();
+    below_chin.windows(2).find_map(|w| {
+        let ((i, t), (j, t_next)) = (w[0], w[1]);
+        let (here, next) = (&sections[i].loops[t], &sections[j].loops[t_next]);
+        let centre = here.bbox_centre().x;
+        let mut beside = (0..sections[i].loops.len())
+            .filter(|&k| k != t)
+            .filter(|&k| sign * (sections[i].loops[k].centroid().x - centre) > 0.0);
+        let arm_loop_here = beside.clone().next().is_some();
+        let joined = beside.find(|&k| overlaps(&sections[i].loops[k], next)).map(Join::Loop);
+        // An arm whose own loop is still beside the torso joins as that loop (its blend may
+        // widen the torso's loop first); only an arm with none below grows out.
+        let grown =
+            !arm_loop_here && reach(next, sign, centre) - reach(here, sign, centre) > ARM_JUMP_MM;
+        let how = joined.or(grown.then_some(Join::Outgrowth))?;
+        Some(ArmJoin { level: i, torso: t, how })
+    })
+}
+
+/// The neck: the narrowest torso level (of `up`) above the higher armpit `armpit_z` and below
+/// the head's widest level above the chin.
+fn neck_level(sections: &[Section], grid: Grid, up: &[(usize, usize)], armpit_z: f64) -> f64 {
+    let chin = grid.floor + CHIN_LEVEL * grid.height;
+    let girths: Vec<(usize, f64)> = up
+        .par_iter()
+        .filter(|&&(i, _)| grid.z(i) > armpit_z || grid.z(i) >= chin)
+        .map(|&(i, k)| (i, sections[i].loops[k].tape_girth()))
+        .collect();
+    let head_widest =
+        girths.iter().filter(|&&(i, _)| grid.z(i) >= chin).max_by(|a, b| a.1.total_cmp(&b.1));
+    girths
+        .iter()
+        .filter(|&&(i, _)| grid.z(i) > armpit_z && head_widest.is_none_or(|h| i < h.0))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(armpit_z + 0.5 * (grid.floor + grid.height - armpit_z), |&(i, _)| grid.z(i))
+}
+
+/// The ankle: the narrowest left-leg level in [`ANKLE_BAND`].
+fn ankle_level(sections: &[Section], grid: Grid, legs: &Legs) -> f64 {
+    (0..legs.crotch_level)
+        .into_par_iter()
+        .filter(|&i| grid.within(i, ANKLE_BAND))
+        .filter_map(|i| legs.loops[i][0].map(|k| (i, sections[i].loops[k].tape_girth())))
+        .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+        .map_or(grid.floor + ANKLE_FALLBACK * grid.height, |(i, _)| grid.z(i))
+}
+
 /// Tracks loops through `sections`, the body's sections every `step` mm from `floor` (at
 /// `floor + step * (i + 0.5)`) over its `height`.
 pub(super) fn track(
@@ -166,126 +320,42 @@ pub(super) fn track(
     height: f64,
     sections: Vec<Section>,
 ) -> Result<BodyRegions, RegionError> {
-    let n = sections.len();
-    let z_of = |i: usize| floor + step * (i as f64 + 0.5);
-
-    let seed = ((0.6 * height / step) as usize).min(n - 1);
+    let grid = Grid { floor, step, height, count: sections.len() };
+    let seed = grid.at(TORSO_SEED_LEVEL);
     if sections[seed].loops.is_empty() {
-        return Err(RegionError::NoTorso { z: z_of(seed) });
+        return Err(RegionError::NoTorso { z: grid.z(seed) });
     }
-    let up = follow(&sections, seed..n, 0);
-
-    // Legs, from their ends: the two largest loops at the shins (below any hand, above the
-    // feet), followed up until both land in one loop (the crotch: where the legs part) and
-    // down to the floor.
-    let shin = ((SHIN_LEVEL * height / step) as usize).min(n - 1);
-    let shins = &sections[shin].loops;
-    if shins.len() < 2 {
-        return Err(RegionError::NoLegs { z: z_of(shin), loops: shins.len() });
-    }
-    let (left_k, right_k) =
-        if shins[0].centroid().x > shins[1].centroid().x { (0, 1) } else { (1, 0) };
-    let mut leg: Vec<[Option<usize>; 2]> = vec![[None, None]; n];
-    let mut apart = [&shins[left_k], &shins[right_k]];
-    let mut crotch_i = None;
-    for i in shin..n {
-        let found = if i == shin {
-            [Some(left_k), Some(right_k)]
-        } else {
-            apart.map(|c| continuing(&sections[i], c))
-        };
-        match found {
-            [Some(l), Some(r)] if l == r => {
-                crotch_i = Some(i);
-                break;
-            }
-            [Some(l), Some(r)] => {
-                leg[i] = [Some(l), Some(r)];
-                apart = [&sections[i].loops[l], &sections[i].loops[r]];
-            }
-            _ => break,
-        }
-    }
-    let Some(crotch_i) = crotch_i.filter(|&i| i <= seed) else {
-        return Err(RegionError::NoCrotch);
-    };
-    for (s, k) in [(0, left_k), (1, right_k)] {
-        for (i, k) in follow(&sections, (0..=shin).rev(), k) {
-            leg[i][s] = Some(k);
-        }
-    }
-    let crotch = refine_crotch(body, z_of(crotch_i - 1), z_of(crotch_i), apart);
-    let down = follow(&sections, (crotch_i..=seed).rev(), 0);
-    let mut torso: Vec<Option<usize>> = vec![None; n];
+    let up = follow(&sections, seed..grid.count, 0);
+    let legs = track_legs(&sections, grid, seed)?;
+    let apart = legs.apart.map(|(i, k)| &sections[i].loops[k]);
+    let crotch =
+        refine_crotch(body, grid.z(legs.crotch_level - 1), grid.z(legs.crotch_level), apart);
+    let down = follow(&sections, (legs.crotch_level..=seed).rev(), 0);
+    let mut torso: Vec<Option<usize>> = vec![None; grid.count];
     for &(i, k) in up.iter().chain(&down) {
         torso[i] = Some(k);
     }
 
-    // Armpits: going up from the seed, the first level where the torso's loop takes in an arm
-    // on that side: a loop beside it joins it (a hanging or A-posed arm at once, a raised
-    // arm's underside as a thin sliver), or the loop reaches out at once much further than the
-    // torso's side could (an arm held out horizontally grows straight out of it, with no
-    // separate loop below).
-    let joining = |sign: f64| {
-        up.windows(2).find_map(|w| {
-            let ((i, t), (j, t_next)) = (w[0], w[1]);
-            let torso_here = &sections[i].loops[t];
-            let centre = torso_here.bbox_centre().x;
-            let next = &sections[j].loops[t_next];
-            let mut beside = (0..sections[i].loops.len())
-                .filter(|&k| k != t)
-                .filter(|&k| sign * (sections[i].loops[k].centroid().x - centre) > 0.0);
-            let arm_loop_here = beside.clone().next().is_some();
-            let joined = beside.find(|&k| overlaps(&sections[i].loops[k], next)).map(Join::Loop);
-            // An arm whose own loop is still beside the torso joins as that loop (its blend may
-            // widen the torso's loop first); only an arm with none below grows out.
-            let grown = !arm_loop_here
-                && reach(next, sign, centre) - reach(torso_here, sign, centre) > ARM_JUMP_MM;
-            joined.or(grown.then_some(Join::Outgrowth)).map(|how| (i, t, how))
-        })
+    let chin = grid.at(CHIN_LEVEL);
+    let arm = |sign: f64, side: &'static str| {
+        arm_join(&sections, &up, chin, sign).ok_or(RegionError::NoArm { side })
     };
-    let (Some(left), Some(right)) = (joining(1.0), joining(-1.0)) else {
-        let side = if joining(1.0).is_none() { "left" } else { "right" };
-        return Err(RegionError::NoArm { side });
-    };
+    let (left, right) = (arm(1.0, "left")?, arm(-1.0, "right")?);
     // The centre line: the torso's bounding-box centre just below the lower armpit.
-    let (i, t, _) = if left.0 <= right.0 { left } else { right };
-    let centre_x = sections[i].loops[t].bbox_centre().x;
-    let armpit_point = |(i, t, how): (usize, usize, Join), sign: f64| {
-        let torso_loop = &sections[i].loops[t];
-        match how {
+    let lower = if left.level <= right.level { left } else { right };
+    let centre_x = sections[lower.level].loops[lower.torso].bbox_centre().x;
+    let armpit_point = |join: ArmJoin, sign: f64| {
+        let (i, torso_loop) = (join.level, &sections[join.level].loops[join.torso]);
+        match join.how {
             Join::Loop(k) => {
-                refine_armpit(body, z_of(i), z_of(i + 1), &sections[i].loops[k], torso_loop)
+                refine_armpit(body, grid.z(i), grid.z(i + 1), &sections[i].loops[k], torso_loop)
             }
-            Join::Outgrowth => refine_outgrowth(body, z_of(i), z_of(i + 1), torso_loop, sign),
+            Join::Outgrowth => refine_outgrowth(body, grid.z(i), grid.z(i + 1), torso_loop, sign),
         }
     };
     let (left_pit, right_pit) = (armpit_point(left, 1.0), armpit_point(right, -1.0));
-    let (left_armpit, right_armpit) = (left_pit.z, right_pit.z);
-
-    // Neck: the narrowest torso level between the armpits and the head's widest level.
-    let armpit_z = left_armpit.max(right_armpit);
-    let head_level = floor + 0.87 * height;
-    let girths: Vec<(usize, f64)> = up
-        .par_iter()
-        .filter(|&&(i, _)| z_of(i) > armpit_z || z_of(i) >= head_level)
-        .map(|&(i, k)| (i, sections[i].loops[k].tape_girth()))
-        .collect();
-    let head_widest =
-        girths.iter().filter(|&&(i, _)| z_of(i) >= head_level).max_by(|a, b| a.1.total_cmp(&b.1));
-    let neck = girths
-        .iter()
-        .filter(|&&(i, _)| z_of(i) > armpit_z && head_widest.is_none_or(|h| i < h.0))
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map_or(armpit_z + 0.5 * (floor + height - armpit_z), |&(i, _)| z_of(i));
-
-    // Ankle: the narrowest left-leg level between 3% and 15% of the height.
-    let ankle = (0..crotch_i)
-        .into_par_iter()
-        .filter(|&i| (0.03..=0.15).contains(&((z_of(i) - floor) / height)))
-        .filter_map(|i| leg[i][0].map(|k| (i, sections[i].loops[k].tape_girth())))
-        .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
-        .map_or(floor + 0.08 * height, |(i, _)| z_of(i));
+    let neck = neck_level(&sections, grid, &up, left_pit.z.max(right_pit.z));
+    let ankle = ankle_level(&sections, grid, &legs);
 
     // Armholes: through each armpit and its shoulder point, facing sideways.
     let armhole = |pit: DVec3, sign: f64, name: &'static str| {
@@ -293,35 +363,45 @@ pub(super) fn track(
             .ok_or(RegionError::NoArm { side: name })?;
         Ok(Armhole::through(pit, shoulder, DVec3::NEG_Y, sign))
     };
-    let left_armhole = armhole(left_pit, 1.0, "left")?;
-    let right_armhole = armhole(right_pit, -1.0, "right")?;
-
     let landmarks = Landmarks {
         height,
         crotch,
         ankle,
-        left_armpit,
-        right_armpit,
+        left_armpit: left_pit.z,
+        right_armpit: right_pit.z,
         neck,
         centre_x,
-        left_armhole,
-        right_armhole,
+        left_armhole: armhole(left_pit, 1.0, "left")?,
+        right_armhole: armhole(right_pit, -1.0, "right")?,
     };
+    let levels = label_levels(sections, grid, &torso, &legs, &landmarks);
+    Ok(BodyRegions { landmarks, labelling: super::Labelling::Tracked { step, levels } })
+}
 
-    let levels = sections
+/// Every tracked level's loops labelled: the tracked torso (at and above the neck, head) and
+/// legs; other loops above the neck or inside the head's loop, head; the rest, arms by side.
+fn label_levels(
+    sections: Vec<Section>,
+    grid: Grid,
+    torso: &[Option<usize>],
+    legs: &Legs,
+    landmarks: &Landmarks,
+) -> Vec<LabelledSection> {
+    let (neck, centre_x) = (landmarks.neck, landmarks.centre_x);
+    sections
         .into_iter()
         .enumerate()
         .map(|(i, section)| {
-            let z = z_of(i);
+            let z = grid.z(i);
             let head_loop = torso[i].filter(|_| z >= neck).map(|k| &section.loops[k]);
             let labels = (0..section.loops.len())
                 .map(|k| {
                     let c = section.loops[k].centroid();
                     if torso[i] == Some(k) {
                         if z >= neck { Region::Head } else { Region::Torso }
-                    } else if leg[i][0] == Some(k) {
+                    } else if legs.loops[i][0] == Some(k) {
                         Region::LeftLeg
-                    } else if leg[i][1] == Some(k) {
+                    } else if legs.loops[i][1] == Some(k) {
                         Region::RightLeg
                     } else if z >= neck || head_loop.is_some_and(|h| h.contains(c)) {
                         Region::Head
@@ -332,6 +412,5 @@ pub(super) fn track(
                 .collect();
             LabelledSection { section, labels }
         })
-        .collect();
-    Ok(BodyRegions { landmarks, labelling: super::Labelling::Tracked { step, levels } })
+        .collect()
 }
