@@ -4,13 +4,15 @@
 //! Layers (defaults from the paper): 100 torso layers from just above the crotch to the neck,
 //! 50 leg layers from the ankles to just below the crotch. Above the armpits the torso sections
 //! are cut at the armholes ([`crate::regions::Armhole`]), so the arms are not part of the
-//! torso: the cut edges stack into flat arm plates. Every torso layer is horizontal and keeps
+//! torso: the cut edges stack into flat arm plates, each rimmed by one smooth curve
+//! ([`arm_plates`]). Every torso layer is horizontal and keeps
 //! its section's girth; above the arm plates the mesh is built from rings bent up over the
 //! shoulders, which follow the shoulder top with its own slope ([`shoulder_cap`]). The legs'
 //! top layers are eased into the hips above them ([`thighs`]), so the crotch join has no step.
 //! All layers share one symmetry plane, x = `axis`: the median of the torso sections'
 //! bounding-box centres.
 
+mod arm_plates;
 mod layers;
 mod rebuild;
 mod shoulder_cap;
@@ -20,6 +22,7 @@ use crate::mesh::Mesh;
 use crate::regions::{Armhole, BodyRegions, Landmarks, Region, RegionError};
 use crate::symmetry::{Preserve, SymmetryError};
 use glam::{DVec2, DVec3};
+use rebuild::TorsoRing;
 use serde::Serialize;
 
 /// How the mannequin is built.
@@ -95,28 +98,33 @@ impl Mannequin {
     /// mirrored, both armpits at their mean height, the centre line on the plane. Its file
     /// carries them ([`crate::scan::carried`]).
     pub fn own_landmarks(&self) -> Landmarks {
-        let m = &self.landmarks;
-        let mirror = |p: DVec3| DVec3::new(2.0 * self.axis - p.x, p.y, p.z);
-        let flip = |n: DVec3| DVec3::new(-n.x, n.y, n.z);
-        let (l, r) = (&m.left_armhole, &m.right_armhole);
-        let left = Armhole {
-            armpit: 0.5 * (l.armpit + mirror(r.armpit)),
-            shoulder_point: 0.5 * (l.shoulder_point + mirror(r.shoulder_point)),
-            normal: (l.normal + flip(r.normal)).normalize_or(l.normal),
-        };
-        let right = Armhole {
-            armpit: mirror(left.armpit),
-            shoulder_point: mirror(left.shoulder_point),
-            normal: flip(left.normal),
-        };
-        Landmarks {
-            left_armpit: left.armpit.z,
-            right_armpit: left.armpit.z,
-            centre_x: self.axis,
-            left_armhole: left,
-            right_armhole: right,
-            ..*m
-        }
+        symmetric_landmarks(&self.landmarks, self.axis)
+    }
+}
+
+/// The landmarks `m` made symmetric about the plane x = `axis` (see
+/// [`Mannequin::own_landmarks`]).
+fn symmetric_landmarks(m: &Landmarks, axis: f64) -> Landmarks {
+    let mirror = |p: DVec3| DVec3::new(2.0 * axis - p.x, p.y, p.z);
+    let flip = |n: DVec3| DVec3::new(-n.x, n.y, n.z);
+    let (l, r) = (&m.left_armhole, &m.right_armhole);
+    let left = Armhole {
+        armpit: 0.5 * (l.armpit + mirror(r.armpit)),
+        shoulder_point: 0.5 * (l.shoulder_point + mirror(r.shoulder_point)),
+        normal: (l.normal + flip(r.normal)).normalize_or(l.normal),
+    };
+    let right = Armhole {
+        armpit: mirror(left.armpit),
+        shoulder_point: mirror(left.shoulder_point),
+        normal: flip(left.normal),
+    };
+    Landmarks {
+        left_armpit: left.armpit.z,
+        right_armpit: left.armpit.z,
+        centre_x: axis,
+        left_armhole: left,
+        right_armhole: right,
+        ..*m
     }
 }
 
@@ -166,12 +174,14 @@ pub fn build(
     let layers::SymmetricLayers { axis, torso, mut left_leg, mut right_leg } =
         layers::symmetric_layers(body, regions, keep, options)?;
     let cap = shoulder_cap::build(body, &regions.landmarks, &torso, axis, options)?;
-    thighs::ease(&torso[0], &mut left_leg, &mut right_leg);
-    let rings: Vec<Vec<DVec3>> = torso
+    thighs::ease(&torso[0], &torso[1], &mut left_leg, &mut right_leg);
+    let own = symmetric_landmarks(&regions.landmarks, axis);
+    let plates = [&own.left_armhole, &own.right_armhole];
+    let rings: Vec<TorsoRing> = torso
         .iter()
         .take_while(|layer| layer.z < cap.from)
-        .map(|layer| layer.points.iter().map(|p| p.extend(layer.z)).collect())
-        .chain(cap.rings)
+        .map(|layer| arm_plates::rim(layer, axis, plates, options.preserve))
+        .chain(cap.rings.iter().map(|ring| TorsoRing::from_rays(ring)))
         .collect();
     let mesh = rebuild::rebuild(
         &rings,

@@ -5,6 +5,8 @@
 //!   corresponding points, and the band's triangles follow the two rings' vertices in order of
 //!   that parameter. Between layers the parameter is the ray index, so ray `i` of one layer
 //!   faces ray `i` of the next (a strip of quads, each split along its shorter diagonal).
+//!   Where both rings meet the arm plates, their parameters are mapped so that their plate
+//!   corners meet ([`band_params`]): the plates' rims run from corner to corner.
 //! - **Torso rings** also get a vertex on the symmetry plane at the front and at the back (the
 //!   midpoint of the edge that crosses it: no change of shape).
 //! - **The crotch** ([`crotch`]): the lowest torso ring sits just above the crotch. A seam
@@ -22,6 +24,7 @@
 use super::Layer;
 use crate::mesh::Mesh;
 use glam::{DVec2, DVec3};
+use std::f64::consts::{PI, TAU};
 
 /// A ring of mesh vertices, closed, counter-clockwise from above, with each vertex's
 /// parameter in `[0, 1)` (the first vertex at 0; see the module documentation).
@@ -107,6 +110,103 @@ fn with_midline(points: &[DVec3]) -> (Vec<DVec3>, usize) {
     out.push(back);
     out.extend_from_slice(&points[half..]);
     (out, half + 1)
+}
+
+/// One torso ring of the mesh: its points (the front midline point first, the left half front
+/// to back, the back midline point, the right half back to front), each with its parameter
+/// for the bands (never decreasing, the front at 0 and the back at 1/2), and where it meets
+/// the arm plates ([`super::arm_plates`]).
+pub(super) struct TorsoRing {
+    pub points: Vec<DVec3>,
+    params: Vec<f64>,
+    back: usize,
+    /// The plate corners: left front, left back, right back, right front (ring order).
+    pub corners: Option<[usize; 4]>,
+}
+
+impl TorsoRing {
+    /// The ring of the `rays - 2` points of a layer's rays (paper eq. 7, see
+    /// [`crate::symmetry`]), lifted onto its surface; each point's parameter is its ray's.
+    pub fn from_rays(points: &[DVec3]) -> TorsoRing {
+        let (points, back) = with_midline(points);
+        let n = points.len() as f64;
+        let params = (0..points.len()).map(|k| k as f64 / n).collect();
+        TorsoRing { points, params, back, corners: None }
+    }
+
+    /// The horizontal ring at height `z` of `points` (counter-clockwise from above, the left
+    /// half first, as the rays' are), mirror-symmetric about the plane x = `axis`, whose chords
+    /// on the left and right plates run between the indices `chords` (left first); each
+    /// point's parameter is its direction from `centre` (as a ray's is).
+    pub fn with_corners(
+        mut points: Vec<DVec2>,
+        z: f64,
+        centre: DVec2,
+        axis: f64,
+        chords: &[(usize, usize)],
+    ) -> TorsoRing {
+        // The front midline point between the last point and the first, the back one where the
+        // ring crosses the plane from the left half to the right.
+        let n = points.len();
+        let cross = (0..n - 1)
+            .find(|&k| points[k].x > axis && points[k + 1].x <= axis)
+            .unwrap_or(n / 2 - 1);
+        let front = (points[n - 1] + points[0]) * 0.5;
+        let back = (points[cross] + points[cross + 1]) * 0.5;
+        points.insert(cross + 1, back);
+        points.insert(0, front);
+        let back = cross + 2;
+        let moved = |k: usize| if k > cross { k + 2 } else { k + 1 };
+        let corners = match chords {
+            &[(a, b), (c, d)] => Some([a, b, c, d].map(moved)),
+            _ => None,
+        };
+        // Directions from the centre, kept from running backwards where a chord point was laid
+        // on its plate across a ray.
+        let mut params: Vec<f64> = Vec::with_capacity(points.len());
+        for (k, &p) in points.iter().enumerate() {
+            let d = match k {
+                0 => 0.0,
+                k if k == back => 0.5,
+                _ => direction_param(p - centre).max(params[k - 1]),
+            };
+            params.push(d);
+        }
+        TorsoRing { points: points.iter().map(|p| p.extend(z)).collect(), params, back, corners }
+    }
+}
+
+/// The parameter of direction `d` in the plane: 0 to the front (-Y), growing counter-clockwise
+/// from above to 1 (as the rays', [`crate::symmetry::rays::direction`]).
+fn direction_param(d: DVec2) -> f64 {
+    ((d.y.atan2(d.x) - 1.5 * PI) / TAU).rem_euclid(1.0)
+}
+
+/// The parameters of the neighbouring torso rings `a` and `b` for the band between them:
+/// where both meet the arm plates, mapped piecewise linearly so that their corners (and the
+/// front and back midlines) fall together at the mean of their own, so corner meets corner
+/// (see [`super::arm_plates`]); elsewhere their own.
+fn band_params(a: &TorsoRing, b: &TorsoRing) -> [Vec<f64>; 2] {
+    let (Some(ca), Some(cb)) = (a.corners, b.corners) else {
+        return [a.params.clone(), b.params.clone()];
+    };
+    let anchors = |r: &TorsoRing, c: [usize; 4]| {
+        [0.0, r.params[c[0]], r.params[c[1]], 0.5, r.params[c[2]], r.params[c[3]], 1.0]
+    };
+    let (from_a, from_b) = (anchors(a, ca), anchors(b, cb));
+    let target: Vec<f64> = from_a.iter().zip(&from_b).map(|(x, y)| 0.5 * (x + y)).collect();
+    let remap = |r: &TorsoRing, from: &[f64]| -> Vec<f64> {
+        r.params
+            .iter()
+            .map(|&p| {
+                let i = (0..from.len() - 2).find(|&i| p <= from[i + 1]).unwrap_or(from.len() - 2);
+                let span = from[i + 1] - from[i];
+                let s = if span > 0.0 { (p - from[i]) / span } else { 0.0 };
+                target[i] + s * (target[i + 1] - target[i])
+            })
+            .collect()
+    };
+    [remap(a, &from_a), remap(b, &from_b)]
 }
 
 /// Cumulative arc length around the closed ring `points`: `len + 1` values from 0 to the
@@ -242,11 +342,11 @@ fn crotch(
     join_leg(mesh, right_top, right);
 }
 
-/// The mannequin mesh from its torso rings (bottom to top, each `rays - 2` points as a torso
-/// layer's, see [`super::shoulder_cap`]) closed by the neck cap around `neck_centre`, its leg
-/// layers (each list bottom to top), its symmetry plane and the crotch height.
+/// The mannequin mesh from its torso rings (bottom to top, see [`super::shoulder_cap`] and
+/// [`super::arm_plates`]) closed by the neck cap around `neck_centre`, its leg layers (each
+/// list bottom to top), its symmetry plane and the crotch height.
 pub(super) fn rebuild(
-    torso: &[Vec<DVec3>],
+    torso: &[TorsoRing],
     neck_centre: DVec3,
     left: &[Layer],
     right: &[Layer],
@@ -255,24 +355,23 @@ pub(super) fn rebuild(
 ) -> Mesh {
     let mut mesh = Mesh::default();
 
-    let mut torso_rings = Vec::with_capacity(torso.len());
-    let mut back = 0;
-    for ring in torso {
-        let (points, b) = with_midline(ring);
-        back = b;
-        let first = mesh.positions.len() as u32;
-        mesh.positions.extend(points);
-        torso_rings.push(Ring::evenly((first..mesh.positions.len() as u32).collect()));
+    let torso_rings: Vec<Vec<u32>> = torso
+        .iter()
+        .map(|ring| {
+            let first = mesh.positions.len() as u32;
+            mesh.positions.extend(&ring.points);
+            (first..mesh.positions.len() as u32).collect()
+        })
+        .collect();
+    for (k, pair) in torso.windows(2).enumerate() {
+        let [lower, upper] = band_params(&pair[0], &pair[1]);
+        stitch(
+            &mut mesh,
+            &Ring { vertices: torso_rings[k].clone(), params: lower },
+            &Ring { vertices: torso_rings[k + 1].clone(), params: upper },
+        );
     }
-    for pair in torso_rings.windows(2) {
-        stitch(&mut mesh, &pair[0], &pair[1]);
-    }
-    cap(
-        &mut mesh,
-        &torso_rings.last().expect("at least two torso rings").vertices,
-        neck_centre,
-        true,
-    );
+    cap(&mut mesh, torso_rings.last().expect("at least two torso rings"), neck_centre, true);
 
     let mut leg_tops = Vec::with_capacity(2);
     for leg in [left, right] {
@@ -290,6 +389,6 @@ pub(super) fn rebuild(
         );
         leg_tops.push(rings.last().expect("at least two leg layers").vertices.clone());
     }
-    crotch(&mut mesh, &torso_rings[0].vertices, back, [&leg_tops[0], &leg_tops[1]], axis, crotch_z);
+    crotch(&mut mesh, &torso_rings[0], torso[0].back, [&leg_tops[0], &leg_tops[1]], axis, crotch_z);
     mesh
 }

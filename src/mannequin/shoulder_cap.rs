@@ -14,7 +14,10 @@
 //! steeply, so consecutive rings sample it along its own slope, whatever that slope is. `k`
 //! grows smoothly from 0 to [`WING_SLOPE`] over [`RAMP_MM`], so the first bent rings continue
 //! the horizontal ones below; since `k` never decreases, every surface lies above the one
-//! before at every `x`, and the rings never cross.
+//! before at every `x`, and the rings never cross. [`ShoulderCap::from`] is the lower shoulder
+//! point's height: every bent surface lies above it, so below the shoulder points every
+//! horizontal slice of the mesh is a torso layer, girth and all, and the arm plates are cut
+//! from horizontal layers only ([`super::arm_plates`]).
 //!
 //! Each bent section is cut at both armholes (the arm plates) and below the neck, made
 //! symmetric as a horizontal section is (paper eq. 5-8) in its projection on the x-y plane —
@@ -121,8 +124,9 @@ pub(super) fn build(
     let shoulder_x = 0.5 * ((l.x - axis).abs() + (r.x - axis).abs());
     let neck = torso.last().expect("at least two torso layers");
     let wing = 0.5 * (half_width(&neck.points, axis) + shoulder_x);
-    // The ring through the shoulder points has its full slope.
-    let from = (shoulder_z - WING_SLOPE * (shoulder_x - wing) - RAMP_MM).max(lm.armpit());
+    // Every bent ring lies above the lower shoulder point: below it every horizontal slice of
+    // the mesh is a torso layer, girth and all.
+    let from = shoulder_z;
     let bends: Vec<(Bend, DVec2)> = torso
         .iter()
         .filter(|layer| layer.z >= from)

@@ -7,9 +7,10 @@
 //! torso ring runs up to 10 mm inside the thigh ring 2 mm below it: a step that the band
 //! between them can only bridge lying flat (a crease of over 100 degrees, a line across the
 //! thighs in a shaded picture). A thigh never sticks out of the hip above it on a body, so
-//! where the top leg ring does, it is pulled in onto the lowest torso ring, and the layers
-//! below follow a smooth fraction of that pull over [`EASE_MM`] of height. Each eased layer
-//! reports the girth of its new shape; the torso is not changed.
+//! where the top leg ring does — beyond the lowest torso ring continued down to it as the body
+//! slopes there ([`continued_down`]) — it is pulled in onto that ring, and the layers below
+//! follow a smooth fraction of that pull over [`EASE_MM`] of height. Each eased layer reports
+//! the girth of its new shape; the torso is not changed.
 
 use super::Layer;
 use super::rebuild::closest_on_ring;
@@ -58,10 +59,67 @@ fn ease_leg(leg: &mut [Layer], hips: &Contour) {
     }
 }
 
-/// Eases both legs' top layers into the lowest torso layer `hips` (see the module
-/// documentation).
-pub(super) fn ease(hips: &Layer, left: &mut [Layer], right: &mut [Layer]) {
-    let hips = Contour { points: hips.points.clone() };
-    ease_leg(left, &hips);
-    ease_leg(right, &hips);
+/// The lowest torso layer `hips` continued down to height `z` as the body slopes between it
+/// and the layer `above` it (ray by ray: both have the same rays), where it widens downward;
+/// elsewhere `hips` itself. Pulling the thigh onto the lowest torso ring itself stood the join
+/// upright where the thigh and the hip slope inward together (12 degrees on a MakeHuman body):
+/// a crease along both its rings, a line across the thighs in a shaded picture.
+fn continued_down(hips: &Layer, above: &Layer, z: f64) -> Contour {
+    let centre = DVec2::from_array(hips.centre);
+    let f = (hips.z - z) / (above.z - hips.z);
+    let points = hips
+        .points
+        .iter()
+        .zip(&above.points)
+        .map(|(&p, &q)| if (p - q).dot(p - centre) > 0.0 { p + (p - q) * f } else { p })
+        .collect();
+    Contour { points }
+}
+
+/// Eases both legs' top layers into the two lowest torso layers `hips` and `above` (see the
+/// module documentation).
+pub(super) fn ease(hips: &Layer, above: &Layer, left: &mut [Layer], right: &mut [Layer]) {
+    for leg in [left, right] {
+        let Some(top_z) = leg.last().map(|top| top.z) else { continue };
+        ease_leg(leg, &continued_down(hips, above, top_z));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::regions::Region;
+    use std::f64::consts::TAU;
+
+    fn circle(z: f64, radius: impl Fn(DVec2) -> f64) -> Layer {
+        let points: Vec<DVec2> = (0..360)
+            .map(|k| {
+                let d = DVec2::from_angle(TAU * k as f64 / 360.0);
+                d * radius(d)
+            })
+            .collect();
+        Layer {
+            region: Region::Torso,
+            z,
+            centre: [0.0, 0.0],
+            points,
+            input_tape_girth: 0.0,
+            input_contour_length: 0.0,
+            tape_girth: 0.0,
+            contour_length: 0.0,
+        }
+    }
+
+    #[test]
+    fn the_hips_continue_down_where_they_widen_downward_and_stay_where_they_overhang() {
+        // The front half (y < 0) narrows upward from 100 to 94 mm over 6 mm; the back half
+        // widens upward from 100 to 106 mm (a buttock overhanging the thigh).
+        let hips = circle(1.0, |_| 100.0);
+        let above = circle(7.0, |d| if d.y < 0.0 { 94.0 } else { 106.0 });
+        let down = continued_down(&hips, &above, -1.0);
+        for p in &down.points {
+            let expected = if p.y < 0.0 { 102.0 } else { 100.0 };
+            assert!((p.length() - expected).abs() < 1e-9, "{p}: {} mm out", p.length());
+        }
+    }
 }

@@ -22,6 +22,28 @@ pub struct AxialRing {
 /// - eq. 6: ray `i` meets the contour at distance `r_i` (farthest crossing);
 /// - eq. 7: each ray and its mirror image take the mean `(r_i + r_(n-i)) / 2`;
 /// - eq. 8: the result is scaled about the centre to the section's original girth.
+///
+/// ```
+/// use dressform::slice::Contour;
+/// use dressform::symmetry::{Preserve, axial};
+/// use glam::DVec2;
+///
+/// // A lopsided section: a 200 x 100 mm box with its left side pushed 40 mm out at the front.
+/// let points = [(-100., -50.), (140., -50.), (100., 50.), (-100., 50.)]
+///     .map(|(x, y)| DVec2::new(x, y))
+///     .to_vec();
+/// let section = Contour { points };
+/// let ring = axial::symmetrize(&section, 0.0, 360, Preserve::Tape).unwrap();
+///
+/// assert_eq!(ring.points.len(), 358); // the two rays on the symmetry line are dropped
+/// let n = ring.points.len();
+/// for (k, p) in ring.points.iter().enumerate() {
+///     let partner = ring.points[n - 1 - k]; // its mirror image about x = 0
+///     assert!((p.x + partner.x).abs() < 1e-9 && (p.y - partner.y).abs() < 1e-9);
+/// }
+/// let symmetric = Contour { points: ring.points };
+/// assert!((symmetric.tape_girth() - section.tape_girth()).abs() < 1e-9); // eq. 8
+/// ```
 pub fn symmetrize(
     section: &Contour,
     axis: f64,

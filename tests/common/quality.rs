@@ -254,6 +254,15 @@ pub fn silhouette_top(mesh: &Mesh, xs: &[f64], ceiling: f64) -> Vec<Option<f64>>
 /// edges of `mesh` whose two triangles (their corners) `counts` accepts: a crease, seen in a
 /// shaded picture as a line.
 pub fn largest_crease(mesh: &Mesh, counts: impl Fn([DVec3; 3], [DVec3; 3]) -> bool) -> f64 {
+    creases(mesh, |a, b, _| counts(a, b)).into_iter().fold(0.0, f64::max)
+}
+
+/// The angle (degrees) between the normals of the two triangles at each edge of `mesh` that
+/// `counts` accepts (given both triangles' corners and the edge's two ends).
+pub fn creases(
+    mesh: &Mesh,
+    counts: impl Fn([DVec3; 3], [DVec3; 3], [DVec3; 2]) -> bool,
+) -> Vec<f64> {
     let mut faces_of_edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
     for (t, tri) in mesh.triangles.iter().enumerate() {
         for k in 0..3 {
@@ -262,15 +271,16 @@ pub fn largest_crease(mesh: &Mesh, counts: impl Fn([DVec3; 3], [DVec3; 3]) -> bo
         }
     }
     let normal = |t: usize| mesh.scaled_normal(t).normalize_or_zero();
+    let ends = |(a, b): (u32, u32)| [a, b].map(|v| mesh.positions[v as usize]);
     faces_of_edge
-        .values()
-        .filter_map(|faces| match faces[..] {
-            [s, t] if counts(mesh.corners(s), mesh.corners(t)) => {
+        .iter()
+        .filter_map(|(&edge, faces)| match faces[..] {
+            [s, t] if counts(mesh.corners(s), mesh.corners(t), ends(edge)) => {
                 Some(normal(s).dot(normal(t)).clamp(-1.0, 1.0).acos().to_degrees())
             }
             _ => None,
         })
-        .fold(0.0, f64::max)
+        .collect()
 }
 
 /// A vertex lies on a plate within this distance of its plane (mm).
