@@ -29,6 +29,7 @@ pub mod lm;
 pub mod params;
 pub mod priors;
 pub mod robust;
+pub mod segment_lengths;
 pub mod verdict;
 
 use correspondences::ScanCloud;
