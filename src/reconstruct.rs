@@ -35,6 +35,9 @@ pub const STEPS: [&str; 3] =
 /// What [`reconstruct`] made.
 #[derive(Debug, Clone)]
 pub struct Reconstruction {
+    /// The model as fitted: the one given with its limb segments' lengths as more shape
+    /// directions ([`fit::segment_lengths`]); `fit`'s beta is its.
+    pub model: BodyModel,
     /// The fitted model.
     pub fit: Fit,
     /// The symmetric pose (one rotation vector per bone).
@@ -76,6 +79,8 @@ pub fn reconstruct(
     mut progress: impl FnMut(usize),
 ) -> Result<Reconstruction, ReconstructError> {
     progress(0);
+    let extended = fit::segment_lengths::extended(model);
+    let model = &extended;
     let body = &scan.body;
     let start = std::time::Instant::now();
     let fitted = fit::fit(model, &fit::ScanPoints::of_mesh(body), &options.fit)?;
@@ -114,6 +119,7 @@ pub fn reconstruct(
         .ok()
         .map(|regions| measure_at(body, &regions, &levels(body, &regions)));
     Ok(Reconstruction {
+        model: extended,
         fit: fitted,
         symmetric,
         residuals,
@@ -167,7 +173,8 @@ pub struct ThreeColumns {
 pub struct FitReport {
     /// Per bone: fitted and symmetric rotation vectors (degrees; see `README.md`, pose).
     pub joints: Vec<JointAngles>,
-    /// The shape coefficients (standard deviations).
+    /// The shape coefficients (standard deviations), the last ones the limb segments' lengths
+    /// ([`fit::segment_lengths`]).
     pub beta: Vec<f64>,
     /// The global translation (mm, canonical frame).
     pub translation_mm: [f64; 3],
@@ -218,8 +225,9 @@ impl Reconstruction {
         MeasurementsReport { table, scan, pose_symmetric: c }
     }
 
-    /// `fit.json` for a fit with `model`.
-    pub fn fit_report(&self, model: &BodyModel) -> FitReport {
+    /// `fit.json`.
+    pub fn fit_report(&self) -> FitReport {
+        let model = &self.model;
         let deg = |v: DVec3| (v * 180.0 / std::f64::consts::PI).to_array();
         let joints = (model.skeleton.names.iter().enumerate())
             .map(|(b, name)| JointAngles {
@@ -242,7 +250,8 @@ impl Reconstruction {
     }
 
     /// `rigged.glb`: the input scan with the skeleton at its fitted joints and its weights.
-    pub fn rigged_glb(&self, scan: &Scan, model: &BodyModel) -> Vec<u8> {
+    pub fn rigged_glb(&self, scan: &Scan) -> Vec<u8> {
+        let model = &self.model;
         let joints = self.fit.joints(model);
         crate::body_model::file::rigged_to_bytes(
             &scan.body,

@@ -26,6 +26,7 @@ mod measurements;
 mod outputs;
 mod pose_symmetry;
 mod pose_symmetry_cases;
+mod pose_symmetry_proportions;
 mod preview;
 mod run_end_to_end;
 mod segmentation;

@@ -48,9 +48,10 @@ const GIRTH_MEAN_TOLERANCE_MM: f64 = 3.0;
 const GIRDLE_TAKES_ARM: &str =
     "an arm above the horizontal: the clavicle and the spine's bend take part of its angle";
 
-const KNOWN_MISSES: [(usize, &str, &str); 18] = [
+const KNOWN_MISSES: [(usize, &str, &str); 19] = [
     (3, "spine bend", "asym/asymm-trunk-1-l bends the trunk itself: the fit reads it as pose"),
     (4, "spine bend", "2.0 degrees read into a straight spine"),
+    (6, "spine bend", "2.1 degrees read into a straight spine since the arms' lengths are free"),
     (13, "spine bend", GIRDLE_TAKES_ARM),
     (14, "arm.L", GIRDLE_TAKES_ARM),
     (14, "clav.L", GIRDLE_TAKES_ARM),
@@ -340,7 +341,7 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         // Angles: the truth in the body's own frame, the fit's in its root's (the yaw).
         let names = &model.skeleton.names;
         let bone = |name: &str| names.iter().position(|n| n == name).unwrap();
-        let fitted_joints = rec.fit.joints(&model);
+        let fitted_joints = rec.fit.joints(&rec.model);
         let root = DQuat::from_scaled_axis(rec.fit.theta[0]);
         let want = limb_angles(joint, DQuat::IDENTITY);
         let got = limb_angles(|n| fitted_joints[bone(n)], root);
@@ -470,9 +471,6 @@ fn remesher() -> Result<String, String> {
 /// same `BodyParams` in the symmetric A-pose captured alike: the pose-symmetric scan's chest,
 /// waist and hip (at the A-pose body's levels) within 5 mm.
 #[test]
-#[ignore = "issue 15 open: the fit does not converge on the sim generator's bodies at all, \
-            asymmetric or not (an arm stays 139-148 mm off, even on the demo's symmetric A-pose \
-            customer), while MakeHuman scans converge; run with --ignored"]
 fn reconstruct_straightens_the_sim_generators_asymmetric_bodies() {
     use sim::capture::{Artifacts, BodyParams, Pose as SimPose, capture, generate};
     let model = BodyModel::builtin();

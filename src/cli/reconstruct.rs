@@ -67,13 +67,13 @@ pub fn run(args: &ReconstructArgs) -> Result<(), Failure> {
     bar.inc(1);
     bar.set_message("writing");
 
-    let fit_json = pretty_json(&done.fit_report(&model))?;
+    let fit_json = pretty_json(&done.fit_report())?;
     let mut outputs = OutputSet::new();
     let (posed, _) = export.place(&done.posed.body, &done.posed.frame);
     outputs.add(export.file_name("posed"), export.encode(&posed));
     let mannequin = done.result.mannequin_file(&export, &done.posed.frame);
     outputs.add(export.file_name("mannequin"), mannequin);
-    outputs.add("rigged.glb", done.rigged_glb(&scan, &model));
+    outputs.add("rigged.glb", done.rigged_glb(&scan));
     let profiles = Profiles::of(&done.result.mannequin, &done.result.comparison.levels);
     outputs.add("profiles.json", pretty_json(&profiles)?);
     outputs.add("measurements.json", pretty_json(&done.measurements())?);

@@ -5,6 +5,7 @@
 
 use super::correspondences::Quadratics;
 use super::params::{Params, Posed, Prepared};
+use super::priors::Priors;
 use glam::DVec3;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -19,8 +20,8 @@ const LAMBDA_DOWN: f64 = 3.0;
 const LAMBDA_MAX: f64 = 1e8;
 
 /// The energy of eq. 4 at `params`: the data cost of the posed vertices plus the priors.
-pub fn energy(prep: &Prepared, data: &Quadratics, params: &Params, posed: &Posed) -> f64 {
-    data.cost(&posed.vertices) + prep.priors.cost(params)
+pub fn energy(priors: &Priors, data: &Quadratics, params: &Params, posed: &Posed) -> f64 {
+    data.cost(&posed.vertices) + priors.cost(params)
 }
 
 /// The result of one iteration.
@@ -35,9 +36,11 @@ pub struct Step {
     pub lambda: f64,
 }
 
-/// One LM iteration over the parameters marked `active`, from `params` (posed as `posed`).
+/// One LM iteration of the data term `data` and the regularisers `priors` over the parameters
+/// marked `active`, from `params` (posed as `posed`).
 pub fn iterate(
     prep: &Prepared,
+    priors: &Priors,
     data: &Quadratics,
     params: &Params,
     posed: &Posed,
@@ -46,13 +49,13 @@ pub fn iterate(
 ) -> Step {
     let n = prep.layout.size();
     let (mut h, mut g) = normal_equations(prep, data, posed);
-    prep.priors.add_to(prep.layout, params, posed, &mut h, &mut g);
+    priors.add_to(prep.layout, params, posed, &mut h, &mut g);
     let parents = &prep.model.skeleton.parents;
     let index: Vec<usize> = (0..n).filter(|&i| active[i]).collect();
     let m = index.len();
     let hr = DMatrix::from_fn(m, m, |r, c| h[(index[r], index[c])]);
     let gr = DVector::from_fn(m, |r, _| g[index[r]]);
-    let before = energy(prep, data, params, posed);
+    let before = energy(priors, data, params, posed);
     let mut lambda = lambda;
     while lambda <= LAMBDA_MAX {
         let mut damped = hr.clone();
@@ -65,7 +68,7 @@ pub fn iterate(
             index.iter().zip(dx.iter()).for_each(|(&i, &d)| full[i] = d);
             let next = params.step(prep.layout, posed, parents, &full);
             let next_posed = prep.pose(&next);
-            let after = energy(prep, data, &next, &next_posed);
+            let after = energy(priors, data, &next, &next_posed);
             if after < before {
                 return Step { params: next, before, after, lambda: lambda / LAMBDA_DOWN };
             }

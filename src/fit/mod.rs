@@ -29,6 +29,7 @@ pub mod lm;
 pub mod params;
 pub mod priors;
 pub mod robust;
+pub mod segment_lengths;
 pub mod verdict;
 
 use correspondences::ScanCloud;
@@ -179,6 +180,7 @@ pub fn fit(
         )));
     }
     let prep = Prepared::new(model);
+    let priors = priors::Priors::new(&model.skeleton);
     let stride = (1.0 / options.sample_fraction.clamp(1e-3, 1.0)).round() as usize;
     let cloud = ScanCloud::new(scan, stride);
     let centre = |p: &[DVec3]| {
@@ -198,7 +200,7 @@ pub fn fit(
             let posed = prep.pose(&params);
             let normals = vertex_normals(&posed.vertices, &model.triangles);
             let data = correspondences::gather(&cloud, &posed.vertices, &normals, stage.sigma_mm);
-            let step = lm::iterate(&prep, &data, &params, &posed, &active, lambda);
+            let step = lm::iterate(&prep, &priors, &data, &params, &posed, &active, lambda);
             iterations += 1;
             params = step.params;
             lambda = step.lambda;

@@ -56,8 +56,6 @@ pub struct Prepared<'m> {
     pub descends: Vec<Vec<bool>>,
     /// The parameter layout.
     pub layout: Layout,
-    /// The regularisers of eq. 4.
-    pub priors: super::priors::Priors,
 }
 
 impl<'m> Prepared<'m> {
@@ -77,7 +75,6 @@ impl<'m> Prepared<'m> {
             joint_directions: model.joint_directions(),
             descends,
             layout: Layout { bones: n, k: model.k() },
-            priors: super::priors::Priors::new(&model.skeleton),
         }
     }
 

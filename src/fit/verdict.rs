@@ -17,12 +17,15 @@ use rayon::prelude::*;
 /// region with no scan at all, is far above.
 pub const MAX_REGION_MEDIAN_MM: f64 = 12.0;
 
-/// The body regions, and the bones whose vertices they hold (by name prefix and side).
+/// The body regions, and the bones whose vertices they hold (by name prefix and side). The
+/// hands are not judged: the mannequin has none, customers hold them every way (a fist, the
+/// fingers spread) and scanners lose fingers, and MakeHuman's densely meshed hand would
+/// outvote the rest of its arm in a median over vertices.
 pub const REGIONS: [(&str, &[&str]); 6] = [
     ("torso", &["root", "spine", "clavicle"]),
     ("head", &["neck", "head"]),
-    ("left arm", &["upperarm01.L", "lowerarm01.L", "wrist.L"]),
-    ("right arm", &["upperarm01.R", "lowerarm01.R", "wrist.R"]),
+    ("left arm", &["upperarm01.L", "lowerarm01.L"]),
+    ("right arm", &["upperarm01.R", "lowerarm01.R"]),
     ("left leg", &["upperleg01.L", "lowerleg01.L", "foot.L"]),
     ("right leg", &["upperleg01.R", "lowerleg01.R", "foot.R"]),
 ];
