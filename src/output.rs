@@ -79,6 +79,13 @@ impl OutputSet {
         self.files.push((name, bytes.into()));
     }
 
+    /// Adds every file of `other`, replacing files of the same names.
+    pub fn append(&mut self, other: OutputSet) {
+        for (name, bytes) in other.files {
+            self.add(name, bytes);
+        }
+    }
+
     /// The names of the files, in the order they were added.
     pub fn names(&self) -> impl Iterator<Item = &str> {
         self.files.iter().map(|(n, _)| n.as_str())
