@@ -13,7 +13,8 @@
 //! - [`mannequin`]: the symmetric mannequin: layers, symmetry, watertight rebuild;
 //! - [`measure`]: height, crotch height, chest/waist/hip girths; Table 1 and Fig. 11;
 //! - [`reconstruct`]: pose symmetry first (fit, rig transfer, re-pose), then the mannequin;
-//! - [`pipeline`]: scan to mannequin in one call; [`profiles`]: the `profiles.json` format;
+//! - [`pipeline`]: one call per command: scan to mannequin, and to a form fitted to it;
+//!   [`profiles`]: the `profiles.json` format; [`outputs`]: a result as its set of files;
 //! - [`preview`]: pictures of a result: `preview.png` and `sections.svg`;
 //! - [`report`]: what `dressform info` says about a scan;
 //! - [`output`]: atomic file writes and all-or-nothing output sets;
@@ -37,6 +38,7 @@ pub mod measure;
 pub mod mesh;
 pub mod messages;
 pub mod output;
+pub mod outputs;
 pub mod pipeline;
 pub mod pose_symmetry;
 pub mod preview;

@@ -21,18 +21,25 @@ use std::path::{Path, PathBuf};
 
 /// Why an output file could not be written.
 #[derive(Debug, thiserror::Error)]
-#[error("{}: cannot write: {source}", path.display())]
+#[error("{}: cannot {doing}: {source}", path.display())]
 pub struct WriteError {
     /// The destination.
     pub path: PathBuf,
+    /// What could not be done: [`WRITE`], or [`CREATE_DIRECTORY`] for an output directory.
+    pub doing: &'static str,
     /// What the operating system said.
     #[source]
     pub source: std::io::Error,
 }
 
+/// [`WriteError::doing`] for a file.
+pub const WRITE: &str = "write";
+/// [`WriteError::doing`] for an output directory that could not be made.
+pub const CREATE_DIRECTORY: &str = "create the directory";
+
 /// Writes `bytes` to `path` atomically (temporary file + rename in the same directory).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
-    let err = |source| WriteError { path: path.to_path_buf(), source };
+    let err = |source| WriteError { path: path.to_path_buf(), doing: WRITE, source };
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -79,6 +86,13 @@ impl OutputSet {
         self.files.push((name, bytes.into()));
     }
 
+    /// Adds every file of `other`, replacing files of the same names.
+    pub fn append(&mut self, other: OutputSet) {
+        for (name, bytes) in other.files {
+            self.add(name, bytes);
+        }
+    }
+
     /// The names of the files, in the order they were added.
     pub fn names(&self) -> impl Iterator<Item = &str> {
         self.files.iter().map(|(n, _)| n.as_str())
@@ -100,10 +114,14 @@ impl OutputSet {
                     std::io::ErrorKind::InvalidInput,
                     "not a plain file name for an output",
                 );
-                return Err(WriteError { path: dir.join(name), source });
+                return Err(WriteError { path: dir.join(name), doing: WRITE, source });
             }
         }
-        std::fs::create_dir_all(dir).map_err(|source| WriteError { path: dir.into(), source })?;
+        std::fs::create_dir_all(dir).map_err(|source| WriteError {
+            path: dir.into(),
+            doing: CREATE_DIRECTORY,
+            source,
+        })?;
         #[cfg(unix)]
         return set::commit(&self.files, dir);
         #[cfg(not(unix))]
@@ -125,7 +143,7 @@ mod set {
 
     /// The error for `path`.
     fn at(path: &Path) -> impl FnOnce(std::io::Error) -> WriteError + '_ {
-        move |source| WriteError { path: path.to_path_buf(), source }
+        move |source| WriteError { path: path.to_path_buf(), doing: super::WRITE, source }
     }
 
     pub(super) fn commit(files: &[(String, Vec<u8>)], dir: &Path) -> Result<(), WriteError> {

@@ -1,15 +1,24 @@
-//! The scan-to-mannequin pipeline as one call: segment, build the symmetric mannequin,
-//! measure both. Used by `symmetrize`, and by `run` and `demo`.
+//! The pipeline as one call per command: [`symmetrize`] (segment the scan, build the
+//! symmetric mannequin, measure both, take its profiles) for `symmetrize`; [`shape`] (that,
+//! then the form fitted to the mannequin and its set-points) for `run` and `demo`, which
+//! drive the form to the result. [`crate::outputs`] turns a result into its files.
 
+use std::collections::BTreeMap;
+
+use form_description::FormDescription;
+
+use crate::fitting::{self, Fit, FitError, region_of, regions_of};
 use crate::mannequin::{self, Mannequin, MannequinError, MannequinOptions};
 use crate::measure::{Comparison, compare, levels};
+use crate::profiles::Profiles;
 use crate::regions::{BodyRegions, TRACKING_STEP_MM};
 use crate::scan::Scan;
 use crate::scan::carried::CarriedBody;
 use crate::scan::format::Export;
 use crate::scan::frame::CanonicalFrame;
+use crate::setpoints::SetPoints;
 
-/// A scan's symmetric mannequin with its segmentation and measurements.
+/// A scan's symmetric mannequin with its segmentation, measurements and profiles.
 #[derive(Debug, Clone)]
 pub struct Symmetrized {
     /// The input body's regions and landmarks.
@@ -18,6 +27,8 @@ pub struct Symmetrized {
     pub mannequin: Mannequin,
     /// Table 1 and Fig. 11.
     pub comparison: Comparison,
+    /// The mannequin's sections as `profiles.json` states them (what the form is fitted to).
+    pub profiles: Profiles,
 }
 
 impl Symmetrized {
@@ -54,5 +65,97 @@ pub fn symmetrize(
         mannequin::build(&scan.body, &regions, &[levels.chest, levels.waist, levels.hip], options)?;
     progress(2);
     let comparison = compare(&scan.body, &regions, &levels, &mannequin);
-    Ok(Symmetrized { regions, mannequin, comparison })
+    let profiles = Profiles::of(&mannequin, &comparison.levels);
+    Ok(Symmetrized { regions, mannequin, comparison, profiles })
+}
+
+/// A scan's mannequin with a form fitted to it: what `run` and `demo` drive the form to.
+#[derive(Debug, Clone)]
+pub struct Shaped {
+    /// The mannequin, its measurements and profiles.
+    pub symmetrized: Symmetrized,
+    /// Where each of the form's rings shapes the mannequin, and how well.
+    pub fit: Fit,
+    /// The fit's set-points, with each ring's target girth.
+    pub setpoints: SetPoints,
+    /// Each ring's girths along the chain, in the form's order.
+    pub rings: Vec<RingGirths>,
+}
+
+/// One ring's girths along the chain, where the ring shapes the body.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RingGirths {
+    /// The ring.
+    pub ring: String,
+    /// The body height it shapes, mm.
+    pub body_z_mm: f64,
+    /// The scan's tape girth there (the section of the ring's region), mm; `None` where the
+    /// scan has no such section.
+    pub scan_mm: Option<f64>,
+    /// The mannequin's tape girth there, mm (0 where the mannequin has no section).
+    pub mannequin_mm: f64,
+}
+
+/// Why [`shape`] failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ShapeError {
+    /// The mannequin could not be built.
+    #[error(transparent)]
+    Mannequin(#[from] MannequinError),
+    /// The form could not be fitted to it.
+    #[error(transparent)]
+    Fit(#[from] FitError),
+}
+
+/// The steps of [`shape`]: those of [`symmetrize`], then the fit.
+pub const SHAPE_STEPS: [&str; 4] = [STEPS[0], STEPS[1], STEPS[2], "fitting the form"];
+
+/// Builds the symmetric mannequin of `scan` and fits `form` to it, calling `progress(step)`
+/// before each of [`SHAPE_STEPS`].
+pub fn shape(
+    scan: &Scan,
+    options: &MannequinOptions,
+    form: &FormDescription,
+    mut progress: impl FnMut(usize),
+) -> Result<Shaped, ShapeError> {
+    let symmetrized = symmetrize(scan, options, &mut progress)?;
+    progress(STEPS.len());
+    let fit = fitting::fit(&symmetrized.profiles, form)?;
+    let setpoints = fit.setpoints();
+    let rings = ring_girths(scan, &symmetrized, form, &fit);
+    Ok(Shaped { symmetrized, fit, setpoints, rings })
+}
+
+/// The scan's and the mannequin's girths at every ring of `form` as `fit` placed them: the
+/// scan is cut once per region, at the heights of all the rings shaping it.
+fn ring_girths(
+    scan: &Scan,
+    symmetrized: &Symmetrized,
+    form: &FormDescription,
+    fit: &Fit,
+) -> Vec<RingGirths> {
+    let mut scanned: BTreeMap<&str, Option<f64>> = BTreeMap::new();
+    for region in regions_of(form) {
+        let rings: Vec<(&str, f64)> = form
+            .rings
+            .iter()
+            .zip(&fit.rings)
+            .filter(|(ring, _)| region_of(ring) == region)
+            .map(|(ring, r)| (ring.name.as_str(), r.mannequin_height_mm))
+            .collect();
+        let heights: Vec<f64> = rings.iter().map(|r| r.1).collect();
+        let sections = symmetrized.regions.sections_of(&scan.body, region, &heights);
+        for (&(name, _), section) in rings.iter().zip(sections) {
+            scanned.insert(name, section.map(|c| c.tape_girth()));
+        }
+    }
+    fit.rings
+        .iter()
+        .map(|r| RingGirths {
+            ring: r.ring.clone(),
+            body_z_mm: r.mannequin_height_mm,
+            scan_mm: scanned.get(r.ring.as_str()).copied().flatten(),
+            mannequin_mm: r.mannequin_girth_mm,
+        })
+        .collect()
 }

@@ -8,7 +8,7 @@
 //! move cannot put another position on the bus. The strokes are the form description's,
 //! which the session has checked against every node's reported capabilities.
 
-use firmware_protocol::Position;
+use firmware_protocol::{HUNDREDTHS_PER_MM, Position};
 
 /// A target position proven to lie within an actuator's stroke.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -21,7 +21,7 @@ impl SafeTarget {
         if !(0.0..=stroke.mm()).contains(&mm) {
             return None;
         }
-        let hundredths = (mm * 100.0).round();
+        let hundredths = (mm * HUNDREDTHS_PER_MM).round();
         // Rounding cannot leave the stroke: the stroke is a whole number of hundredths.
         let raw = (hundredths as u16).min(stroke.hundredths_mm());
         Position::new(raw).map(Self)
@@ -30,7 +30,8 @@ impl SafeTarget {
     /// `mm` clamped into `[0, stroke]` (NaN becomes 0, the home end).
     pub fn clamped(mm: f64, stroke: Position) -> Self {
         let top = f64::from(stroke.hundredths_mm());
-        let hundredths = if mm.is_nan() { 0.0 } else { (mm * 100.0).round().clamp(0.0, top) };
+        let hundredths =
+            if mm.is_nan() { 0.0 } else { (mm * HUNDREDTHS_PER_MM).round().clamp(0.0, top) };
         // `hundredths` is within the stroke, itself a valid position.
         Self(Position::new(hundredths as u16).unwrap_or(Position::ZERO))
     }

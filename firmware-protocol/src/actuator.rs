@@ -102,6 +102,14 @@ impl FromIterator<Actuator> for ActuatorSet {
     }
 }
 
+/// Hundredths of a millimetre in one: the wire's unit of length (positions, and the details
+/// of emergencies about lengths) and of speed (0.01 mm/s). The one conversion factor between
+/// the wire's lengths and millimetres, for host and nodes alike.
+pub const HUNDREDTHS_PER_MM: f64 = 100.0;
+
+/// Tenths of a mm/s² in one: the wire's unit of acceleration (0.1 mm/s²).
+pub const TENTHS_PER_MM_S2: f64 = 10.0;
+
 /// A position along an actuator's stroke: 0.01 mm from its home end, at most 655.34 mm.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Position(u16);
@@ -119,7 +127,7 @@ impl Position {
 
     /// The position rounded to 0.01 mm, if `mm` is a number in 0..=655.34.
     pub fn from_mm(mm: f32) -> Option<Self> {
-        let hundredths = mm * 100.0 + 0.5;
+        let hundredths = mm * HUNDREDTHS_PER_MM as f32 + 0.5;
         // The negated comparison also rejects NaN.
         if !(0.0..(NO_POSITION as f32)).contains(&hundredths) {
             return None;
@@ -135,7 +143,7 @@ impl Position {
     /// The position in millimetres (exactly the nearest `f64` to the decimal value: the one
     /// conversion from the wire's hundredths the host uses).
     pub fn mm(self) -> f64 {
-        f64::from(self.0) / 100.0
+        f64::from(self.0) / HUNDREDTHS_PER_MM
     }
 }
 
@@ -162,7 +170,7 @@ impl Speed {
 
     /// The speed rounded to 0.01 mm/s, if `mm_s` is a number in 0..=655.35.
     pub fn from_mm_s(mm_s: f64) -> Option<Self> {
-        round_to_wire(mm_s * 100.0).map(Self)
+        round_to_wire(mm_s * HUNDREDTHS_PER_MM).map(Self)
     }
 
     /// The speed in 0.01 mm/s (the wire value).
@@ -172,7 +180,7 @@ impl Speed {
 
     /// The speed in mm/s.
     pub fn mm_s(self) -> f64 {
-        f64::from(self.0) / 100.0
+        f64::from(self.0) / HUNDREDTHS_PER_MM
     }
 }
 
@@ -189,7 +197,7 @@ impl Accel {
 
     /// The acceleration rounded to 0.1 mm/s², if `mm_s2` is a number in 0..=6553.5.
     pub fn from_mm_s2(mm_s2: f64) -> Option<Self> {
-        round_to_wire(mm_s2 * 10.0).map(Self)
+        round_to_wire(mm_s2 * TENTHS_PER_MM_S2).map(Self)
     }
 
     /// The acceleration in 0.1 mm/s² (the wire value).
@@ -199,7 +207,7 @@ impl Accel {
 
     /// The acceleration in mm/s².
     pub fn mm_s2(self) -> f64 {
-        f64::from(self.0) / 10.0
+        f64::from(self.0) / TENTHS_PER_MM_S2
     }
 }
 

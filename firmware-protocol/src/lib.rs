@@ -54,7 +54,9 @@ pub mod timing;
 pub mod update;
 pub mod version;
 
-pub use actuator::{Accel, Actuator, ActuatorSet, Position, Speed};
+pub use actuator::{
+    Accel, Actuator, ActuatorSet, HUNDREDTHS_PER_MM, Position, Speed, TENTHS_PER_MM_S2,
+};
 pub use error::Error;
 pub use message::{Address, Code, Message, NodeId, Packet};
 pub use version::{PROTOCOL_VERSION, ProtocolVersion};

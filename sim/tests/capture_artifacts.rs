@@ -1,15 +1,12 @@
-//! Scanner artifacts: exact unit and axis conversions, holes with boundary loops at the
-//! requested places, noise of the requested deviation, determinism.
-
-use crate::topology;
+//! Scanner artifacts: exact unit and axis conversions, holes at the requested places, noise
+//! of the requested deviation, determinism. (That each hole is one simple boundary loop is
+//! checked with dressform's topology in the root crate's `tests/synthetic_bodies.rs`.)
 
 use std::sync::OnceLock;
 
 use sim::capture::{
     Artifacts, BodyParams, HoleSite, SyntheticBody, Units, UpAxis, capture, generate,
 };
-
-use topology::topology;
 
 /// One default body shared by the tests of this file (generated once).
 fn body() -> &'static SyntheticBody {
@@ -73,30 +70,6 @@ fn yaw_turns_about_the_vertical() {
 }
 
 #[test]
-fn holes_leave_one_simple_loop_per_site() {
-    let b = body();
-    for (sites, loops) in [
-        (vec![HoleSite::Armpits], 2),
-        (vec![HoleSite::Crotch], 1),
-        (vec![HoleSite::Soles], 2),
-        (vec![HoleSite::Armpits, HoleSite::Crotch, HoleSite::Soles], 5),
-    ] {
-        let artifacts = Artifacts { holes: sites.clone(), ..Artifacts::default() };
-        let s = capture(b, &artifacts);
-        let t = topology(&s);
-        assert_eq!(t.boundary_loops, loops, "{sites:?}: {t:?}");
-        assert_eq!(t.bad_edges, 0, "{sites:?}: {t:?}");
-        assert_eq!(t.non_manifold_vertices, 0, "{sites:?}: {t:?}");
-        assert_eq!(t.unused_vertices, 0, "{sites:?}: {t:?}");
-        assert_eq!(t.components, 1, "{sites:?}: {t:?}");
-        // Each hole is a disk removed from a sphere: Euler characteristic 2 - loops.
-        assert_eq!(t.euler, 2 - loops as i64, "{sites:?}: {t:?}");
-        // Small holes: most of the surface stays.
-        assert!(s.triangles.len() as f64 > 0.97 * b.surface.triangles.len() as f64);
-    }
-}
-
-#[test]
 fn holes_are_where_the_sites_are() {
     let b = body();
     let s = capture(
@@ -141,15 +114,4 @@ fn noise_has_the_requested_deviation_and_is_seeded() {
         let clean = capture(b, &Artifacts { noise_sigma_mm: bad, ..Artifacts::default() });
         assert_eq!(clean, b.surface);
     }
-}
-
-#[test]
-fn typical_scanner_combines_everything() {
-    let b = body();
-    let s = capture(b, &Artifacts::typical_scanner(3));
-    let t = topology(&s);
-    assert_eq!(t.boundary_loops, 5, "{t:?}");
-    let (lo, hi) = s.bounds().expect("vertices");
-    // Metres, Y up.
-    assert!((hi[1] - lo[1] - 1.7).abs() < 0.01, "{lo:?} {hi:?}");
 }

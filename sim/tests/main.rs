@@ -1,13 +1,9 @@
 //! The integration tests of this crate, as one test binary (each module was its own binary;
 //! one binary links the crate once).
 
-#[path = "support/section.rs"]
-mod section;
 #[path = "../../tests/common/skip.rs"]
 mod skip;
 mod test_host;
-#[path = "support/topology.rs"]
-mod topology;
 
 mod body_params;
 mod bus_budget;

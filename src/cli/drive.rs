@@ -152,37 +152,28 @@ pub fn execute(
     let progress = |p: &Progress| display.update(p);
     let runtime = runtime()?;
     let result = runtime.block_on(async {
-        match link {
-            LinkSpec::Sim => {
-                let config = SimConfig { faults, log: sim.log.clone(), ..SimConfig::default() };
-                let rig = link::simulated(form, &config)?;
-                let transport = rig.attach();
-                let _armed = link::arm(&transport);
-                let driving = drive(transport, form, setpoints, options, progress);
-                // The log's health, watched while the form moves.
-                let log_watch = async {
-                    loop {
-                        tokio::time::sleep(LOG_CHECK).await;
-                        if let Some(e) = rig.log_failure() {
-                            errln!("error: {e} (the move goes on)");
-                            std::future::pending::<()>().await;
-                        }
-                    }
-                };
-                let report = tokio::select! {
-                    report = driving => report,
-                    () = log_watch => unreachable!("the log watch never ends"),
-                };
-                rig.finish().map_err(link::sim_failure)?;
-                report.map_err(Failure::from)
+        let config = SimConfig { faults, log: sim.log.clone(), ..SimConfig::default() };
+        let owned = link::own(link, form, &config)?;
+        let driving = drive(owned.connection, form, setpoints, options, progress);
+        let Some(rig) = owned.rig else {
+            return driving.await.map_err(Failure::from);
+        };
+        // The simulated bus's log, watched while the form moves.
+        let log_watch = async {
+            loop {
+                tokio::time::sleep(LOG_CHECK).await;
+                if let Some(e) = rig.log_failure() {
+                    errln!("error: {e} (the move goes on)");
+                    std::future::pending::<()>().await;
+                }
             }
-            spec => {
-                let owned = link::own(spec)?;
-                drive(owned.connection, form, setpoints, options, progress)
-                    .await
-                    .map_err(Into::into)
-            }
-        }
+        };
+        let report = tokio::select! {
+            report = driving => report,
+            () = log_watch => unreachable!("the log watch never ends"),
+        };
+        rig.finish().map_err(link::sim_failure)?;
+        report.map_err(Failure::from)
     });
     display.finish();
     result

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use dressform::controller::control::Endpoint;
+use dressform::controller::open::{OpenError, OpenLink};
 use dressform::controller::simulated::{SimConfig, SimDriveError, SimulatedRig};
 use dressform::controller::{Connection, LinkSpec, Transport};
 use form_description::FormDescription;
@@ -73,37 +74,38 @@ pub fn runtime() -> Result<tokio::runtime::Runtime, Failure> {
         .map_err(|e| Failure::other(format!("cannot start the runtime: {e}")))
 }
 
-/// A hardware link owned by this process: e-stops from another terminal and from signals
-/// reach it until it is dropped.
+/// A link owned by this process (on hardware, or the simulated form started for it): e-stops
+/// from another terminal and from signals reach it until it is dropped.
 pub struct Owned {
     pub connection: Connection,
+    /// The simulated form, with `--sim`.
+    pub rig: Option<SimulatedRig>,
     _armed: Armed,
     // Dropped after the connection's session: the endpoint answers to the end.
     _endpoint: Option<Endpoint>,
 }
 
-/// Opens a hardware link and owns it: binds its control endpoint first (refusing a link
+/// Opens the link `spec` names and owns it: binds its control endpoint first (refusing a link
 /// another dressform process owns, before anything is written to the device), then opens it
-/// and arms the endpoint and the signals with its gate.
-pub fn own(spec: &LinkSpec) -> Result<Owned, Failure> {
+/// (with `--sim`, starts the simulated `form` as `sim` says) and arms the endpoint and the
+/// signals with its gate. Must be called within a tokio runtime.
+pub fn own(spec: &LinkSpec, form: &FormDescription, sim: &SimConfig) -> Result<Owned, Failure> {
     let endpoint = Endpoint::bind(spec).map_err(Failure::other)?;
-    let connection = Connection::open(spec).map_err(Failure::other)?;
+    let OpenLink { connection, rig } = OpenLink::open(spec, form, sim).map_err(|e| match e {
+        OpenError::Hardware(e) => Failure::other(e),
+        OpenError::Sim(e) => sim_failure(e),
+    })?;
     if let Some(endpoint) = &endpoint {
         endpoint.arm(connection.gate()).map_err(Failure::other)?;
     }
     let armed = signals::arm(connection.gate());
-    Ok(Owned { connection, _armed: armed, _endpoint: endpoint })
+    Ok(Owned { connection, rig, _armed: armed, _endpoint: endpoint })
 }
 
-/// Starts the in-process simulated form; its link, once attached, is armed for signals by
-/// [`arm`].
+/// Starts the in-process simulated form (for a command that watches it rather than drives
+/// it: `estop --sim`).
 pub fn simulated(form: &FormDescription, config: &SimConfig) -> Result<SimulatedRig, Failure> {
     SimulatedRig::start(form, config).map_err(sim_failure)
-}
-
-/// Arms a link this process made (the simulated form's) for signals.
-pub fn arm<T: Transport>(transport: &T) -> Armed {
-    signals::arm(transport.gate())
 }
 
 /// How a simulated form's failure ends the command: its description or faults are bad

@@ -6,7 +6,7 @@ use super::Failure;
 use super::link::{self, FormArg, LinkArgs, runtime};
 use dressform::controller::faults::describe;
 use dressform::controller::simulated::SimConfig;
-use dressform::controller::{LinkSpec, ResetReport, reset};
+use dressform::controller::{ResetReport, reset};
 
 #[derive(Debug, clap::Args)]
 pub struct ResetArgs {
@@ -19,18 +19,8 @@ pub struct ResetArgs {
 pub fn run(args: &ResetArgs) -> Result<(), Failure> {
     let form = args.form.load()?;
     let report = runtime()?.block_on(async {
-        match args.link.spec() {
-            LinkSpec::Sim => {
-                let rig = link::simulated(&form, &SimConfig::default())?;
-                let transport = rig.attach();
-                let _armed = link::arm(&transport);
-                reset(transport, &form).await.map_err(Failure::other)
-            }
-            spec => {
-                let owned = link::own(&spec)?;
-                reset(owned.connection, &form).await.map_err(Failure::other)
-            }
-        }
+        let owned = link::own(&args.link.spec(), &form, &SimConfig::default())?;
+        reset(owned.connection, &form).await.map_err(Failure::other)
     })?;
     print(&report)
 }

@@ -6,21 +6,17 @@
 
 use super::drive::{ShapeArgs, SimArgs, execute, shape_verdict};
 use super::link::{FormArg, LinkArgs};
-use super::setpoints::{fidelity_table, setpoints_of};
+use super::setpoints::fidelity_table;
 use super::{Failure, FrameArgs, SmoothArgs, progress_bar, warn};
 use dressform::controller::{DriveOptions, LinkSpec};
-use dressform::fitting::{Fit, ShapeOutcome, compare, fit, region_of};
+use dressform::fitting::{ShapeOutcome, compare};
 use dressform::mannequin::MannequinOptions;
 use dressform::mesh::topology;
 use dressform::output::OutputSet;
-use dressform::pipeline::{STEPS, Symmetrized, symmetrize};
-use dressform::preview::{preview_png, sections_svg};
-use dressform::profiles::Profiles;
-use dressform::regions::Region;
+use dressform::outputs::Outputs;
+use dressform::pipeline::{RingGirths, SHAPE_STEPS, Symmetrized, shape};
 use dressform::scan::{self, Scan, format::Export, format::Format};
-use dressform::setpoints::SetPoints;
 use form_description::FormDescription;
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]
@@ -82,27 +78,27 @@ pub fn shape_form(
     form: &FormDescription,
     drive: &Drive,
     out: &Path,
-    outputs: OutputSet,
+    mut outputs: OutputSet,
 ) -> Result<(Symmetrized, ShapeOutcome), Failure> {
     let file = scan.source.display().to_string();
-    let bar = progress_bar(false, STEPS.len() as u64 + 1);
-    let result = symmetrize(scan, &MannequinOptions::default(), |step| {
+    let bar = progress_bar(false, SHAPE_STEPS.len() as u64);
+    let shaped = shape(scan, &MannequinOptions::default(), form, |step| {
         bar.inc(1);
-        bar.set_message(STEPS[step]);
+        bar.set_message(SHAPE_STEPS[step]);
     })
     .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
-    bar.set_message("fitting the form");
-    let profiles = Profiles::of(&result.mannequin, &result.comparison.levels);
-    let fitted = fit(&profiles, form).map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
-    let setpoints = setpoints_of(&fitted);
-    write_outputs(out, scan, outputs, &result, &profiles, &setpoints)?;
+    let export = Export::canonical(Format::Obj);
+    let files = Outputs::of(&shaped.symmetrized, scan, &export).with_setpoints(&shaped.setpoints);
+    outputs.append(files.files().map_err(Failure::other)?);
+    outputs.commit(out).map_err(Failure::other)?;
     bar.finish_and_clear();
 
     outln!("Symmetric mannequin and set-points written to {}.", out.display());
     outln!("Fit of form \"{}\" (ring heights on the form and on the body):", form.name);
-    out!("{}", fidelity_table(&fitted));
+    out!("{}", fidelity_table(&shaped.fit));
     outln!();
-    let report = execute(form, &setpoints, drive.link, drive.options, drive.sim, false)?;
+    let setpoints = &shaped.setpoints;
+    let report = execute(form, setpoints, drive.link, drive.options, drive.sim, false)?;
     for warning in &report.warnings {
         errln!("warning: {warning}");
     }
@@ -121,42 +117,14 @@ pub fn shape_form(
         }
     );
     outln!();
-    out!("{}", girth_table(scan, &result, form, &fitted, &shape));
-    Ok((result, shape))
-}
-
-fn write_outputs(
-    out: &Path,
-    scan: &Scan,
-    mut outputs: OutputSet,
-    result: &Symmetrized,
-    profiles: &Profiles,
-    setpoints: &SetPoints,
-) -> Result<(), Failure> {
-    std::fs::create_dir_all(out).map_err(|e| {
-        Failure::other(format!("{}: cannot create the directory: {e}", out.display()))
-    })?;
-    let export = Export::canonical(Format::Obj);
-    outputs.add(export.file_name("mannequin"), result.mannequin_file(&export, &scan.frame));
-    outputs.add("profiles.json", serde_json::to_vec_pretty(profiles).map_err(Failure::other)?);
-    let measurements = serde_json::to_vec_pretty(&result.comparison).map_err(Failure::other)?;
-    outputs.add("measurements.json", measurements);
-    outputs.add("setpoints.json", setpoints.to_json_string());
-    outputs.add("preview.png", preview_png(&[(&scan.body, "scan")], result));
-    outputs.add("sections.svg", sections_svg(&scan.body, result));
-    outputs.commit(out).map_err(Failure::other)
+    out!("{}", girth_table(&shaped.rings, &shape));
+    Ok((shaped.symmetrized, shape))
 }
 
 /// Scan, mannequin and form girths at every ring: the scan's section where the ring shapes
 /// the body, the mannequin's there, and the form's skin at the positions reached, with the
 /// ring's status.
-fn girth_table(
-    scan: &Scan,
-    result: &Symmetrized,
-    form: &FormDescription,
-    fitted: &Fit,
-    shape: &ShapeOutcome,
-) -> String {
+fn girth_table(rings: &[RingGirths], shape: &ShapeOutcome) -> String {
     use std::fmt::Write;
     let mut s = String::new();
     let _ = writeln!(
@@ -164,35 +132,16 @@ fn girth_table(
         "  {:<12} {:>9} {:>9} {:>11} {:>9}  status",
         "girth (mm)", "body z", "scan", "mannequin", "form"
     );
-    // The scan's sections: one sweep per region for all its rings.
-    let mut scanned: BTreeMap<String, String> = BTreeMap::new();
-    for region in [Region::Torso, Region::LeftLeg, Region::RightLeg] {
-        let rings: Vec<(&str, f64)> = form
-            .rings
-            .iter()
-            .zip(&fitted.rings)
-            .filter(|(ring, _)| region_of(ring) == region)
-            .map(|(ring, r)| (ring.name.as_str(), r.mannequin_height_mm))
-            .collect();
-        let heights: Vec<f64> = rings.iter().map(|r| r.1).collect();
-        for ((name, _), c) in
-            rings.iter().zip(result.regions.sections_of(&scan.body, region, &heights))
-        {
-            let girth = c.map_or_else(|| "-".to_string(), |c| format!("{:.1}", c.tape_girth()));
-            scanned.insert(name.to_string(), girth);
-        }
-    }
-    for (ring, r) in form.rings.iter().zip(&fitted.rings) {
-        let z = r.mannequin_height_mm;
-        let scanned = &scanned[&ring.name];
-        let (reached, status) = match shape.rings.iter().find(|o| o.ring == ring.name) {
+    for r in rings {
+        let scanned = r.scan_mm.map_or_else(|| "-".to_string(), |g| format!("{g:.1}"));
+        let (reached, status) = match shape.rings.iter().find(|o| o.ring == r.ring) {
             Some(o) => (format!("{:.1}", o.reached_mm), shape.status(o)),
             None => ("-".into(), "no body".into()),
         };
         let _ = writeln!(
             s,
             "  {:<12} {:>9.0} {:>9} {:>11.1} {:>9}  {status}",
-            ring.name, z, scanned, r.mannequin_girth_mm, reached
+            r.ring, r.body_z_mm, scanned, r.mannequin_mm, reached
         );
     }
     s

@@ -7,7 +7,6 @@ use super::Failure;
 use super::link::FormArg;
 use dressform::fitting::{Fit, SHAPE_NOTE_MM, fit, regions_of};
 use dressform::profiles::Profiles;
-use dressform::setpoints::SetPoints;
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
@@ -30,7 +29,7 @@ pub fn run(args: &SetpointsArgs) -> Result<(), Failure> {
         Profiles::load(&args.profiles, &regions_of(&form)).map_err(Failure::bad_input)?;
     let fitted = fit(&profiles, &form)
         .map_err(|e| Failure::bad_input(format!("{}: {e}", args.profiles.display())))?;
-    setpoints_of(&fitted).save(&args.out).map_err(Failure::other)?;
+    fitted.setpoints().save(&args.out).map_err(Failure::other)?;
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&fitted).map_err(Failure::other)?);
     } else {
@@ -38,12 +37,6 @@ pub fn run(args: &SetpointsArgs) -> Result<(), Failure> {
         outln!("set-points written to {}", args.out.display());
     }
     Ok(())
-}
-
-/// The set-point file of a fit, with each ring's target girth.
-pub fn setpoints_of(fitted: &Fit) -> SetPoints {
-    SetPoints::new(fitted.form.clone(), fitted.positions_mm.clone())
-        .with_target_girths(fitted.target_girths())
 }
 
 /// The fidelity report as a table, with a line per ring whose shape or girth is limited.

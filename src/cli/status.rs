@@ -29,18 +29,8 @@ pub fn run(args: &StatusArgs) -> Result<(), Failure> {
     let form = args.form.load()?;
     let spec = args.link.spec();
     let reports = runtime()?.block_on(async {
-        match &spec {
-            LinkSpec::Sim => {
-                let rig = link::simulated(&form, &SimConfig::default())?;
-                let transport = rig.attach();
-                let _armed = link::arm(&transport);
-                status(transport, &form, LISTEN).await.map_err(Failure::other)
-            }
-            spec => {
-                let owned = link::own(spec)?;
-                status(owned.connection, &form, LISTEN).await.map_err(Failure::other)
-            }
-        }
+        let owned = link::own(&spec, &form, &SimConfig::default())?;
+        status(owned.connection, &form, LISTEN).await.map_err(Failure::other)
     })?;
     if spec == LinkSpec::Sim && !args.json {
         outln!(

@@ -5,10 +5,8 @@
 use super::{ExportArgs, Failure, MannequinArgs, ScanFrameArgs, SmoothArgs, progress_bar, warn};
 use dressform::measure::Comparison;
 use dressform::mesh::topology;
-use dressform::output::OutputSet;
+use dressform::outputs::Outputs;
 use dressform::pipeline::{STEPS, symmetrize};
-use dressform::preview::{preview_png, sections_svg};
-use dressform::profiles::Profiles;
 use dressform::scan;
 use std::path::PathBuf;
 
@@ -52,21 +50,11 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     bar.inc(1);
     bar.set_message("writing");
 
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        Failure::other(format!("{}: cannot create the directory: {e}", args.out.display()))
-    })?;
-    let measurements = pretty_json(&result.comparison)?;
-    let mut outputs = OutputSet::new();
-    outputs.add(export.file_name("mannequin"), result.mannequin_file(&export, &scan.frame));
-    let profiles = Profiles::of(&result.mannequin, &result.comparison.levels);
-    outputs.add("profiles.json", pretty_json(&profiles)?);
-    outputs.add("measurements.json", measurements.clone());
-    outputs.add("preview.png", preview_png(&[(&scan.body, "scan")], &result));
-    outputs.add("sections.svg", sections_svg(&scan.body, &result));
+    let outputs = Outputs::of(&result, &scan, &export).files().map_err(Failure::other)?;
     outputs.commit(&args.out).map_err(Failure::other)?;
     bar.finish_and_clear();
     if args.json {
-        outln!("{measurements}");
+        outln!("{}", pretty_json(&result.comparison)?);
     } else {
         print_table(&file, &result.comparison, &args.out);
     }

@@ -10,6 +10,7 @@
 
 use std::fmt;
 
+use firmware_protocol::HUNDREDTHS_PER_MM;
 use firmware_protocol::drive::{AckStatus, DriveState, EmergencyCode, Faults};
 
 /// Faults a drive clears at start on its own: latched by a stop or by the host, not by the
@@ -73,9 +74,13 @@ pub fn code_name(code: EmergencyCode) -> String {
         .map_or_else(|| format!("unknown code 0x{:04X}", code.0), |(_, name)| (*name).to_string())
 }
 
+/// Tenths of a degree in one: an over-temperature's detail is in 0.1 °C
+/// ([`EmergencyCode::OVERTEMPERATURE`]).
+const TENTHS_PER_DEGREE: f64 = 10.0;
+
 /// An emergency event in words, with its detail in its unit: `following error of 1.23 mm`.
 pub fn event_words(code: EmergencyCode, detail: i32) -> String {
-    let mm = |hundredths: i32| format!("{:.2} mm", f64::from(hundredths) / 100.0);
+    let mm = |hundredths: i32| format!("{:.2} mm", f64::from(hundredths) / HUNDREDTHS_PER_MM);
     match code {
         EmergencyCode::FOLLOWING_ERROR => {
             format!("following error of {} (jammed, or its encoder failed)", mm(detail))
@@ -83,7 +88,7 @@ pub fn event_words(code: EmergencyCode, detail: i32) -> String {
         EmergencyCode::HOST_TIMEOUT => format!("host timeout: no host heartbeat for {detail} ms"),
         EmergencyCode::OVERCURRENT => format!("overcurrent: {detail} mA"),
         EmergencyCode::OVERTEMPERATURE => {
-            format!("overtemperature: {:.1} °C", f64::from(detail) / 10.0)
+            format!("overtemperature: {:.1} °C", f64::from(detail) / TENTHS_PER_DEGREE)
         }
         EmergencyCode::UNDERVOLTAGE => format!("undervoltage: {detail} mV"),
         EmergencyCode::OVERVOLTAGE => format!("overvoltage: {detail} mV"),

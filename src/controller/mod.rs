@@ -13,6 +13,7 @@
 //! | [`session`] | discovery, fault reset, enable/home, heartbeats and polls, liveness, faults, reboots |
 //! | [`motion`] | staging, the common SYNC duration, watching feedback, the report |
 //! | [`faults`] | states, faults, events and refusals in words; which faults the host clears |
+//! | [`open`] | opening the link a [`LinkSpec`] names, starting the simulated form for `--sim` |
 //! | [`simulated`] | the whole thing on the in-process simulated form |
 //!
 //! Safety rules, all enforced here: targets come only from [`SafeTarget`]s built against the
@@ -26,6 +27,7 @@
 pub mod control;
 pub mod faults;
 pub mod motion;
+pub mod open;
 pub mod session;
 pub mod simulated;
 pub mod transport;
@@ -52,6 +54,16 @@ pub type Clamped = Vec<(String, f64, f64)>;
 
 /// The default tolerance, mm.
 pub const DEFAULT_TOLERANCE_MM: f64 = 0.1;
+
+/// How long past a move's planned duration the actuators may take to arrive by default: a
+/// drive's position loop settles in tens of milliseconds; the rest is margin for a node that
+/// was busy or a host under load.
+pub const DEFAULT_SETTLE: Duration = Duration::from_secs(2);
+
+/// How long homing may take by default: a node homes by creeping to its switch at its homing
+/// speed (5 mm/s by default), so the reference form's longest stroke, 60 mm, takes 12 s; 30 s
+/// leaves room for a slower homing speed and a node homed last.
+pub const DEFAULT_HOMING_TIMEOUT: Duration = Duration::from_secs(30);
 
 /// How a drive runs.
 #[derive(Clone, Debug)]
@@ -81,8 +93,8 @@ impl Default for DriveOptions {
             tolerance_mm: DEFAULT_TOLERANCE_MM,
             slower: 1.0,
             min_duration: Duration::ZERO,
-            settle: Duration::from_secs(2),
-            homing_timeout: Duration::from_secs(30),
+            settle: DEFAULT_SETTLE,
+            homing_timeout: DEFAULT_HOMING_TIMEOUT,
             reset_faults: false,
         }
     }

@@ -182,7 +182,7 @@ pub async fn run<T: Transport>(
     let mut settled: BTreeMap<String, u64> = BTreeMap::new();
     loop {
         let deadline = started + planned + options.settle;
-        let tick = (Instant::now() + Duration::from_millis(50)).min(deadline);
+        let tick = (Instant::now() + PROGRESS_PERIOD).min(deadline);
         let tol = options.tolerance_mm;
         let done = session.wait_until(tick, |s| all_within(s, plan, tol)).await?;
         for t in plan {
@@ -240,7 +240,8 @@ pub async fn run<T: Transport>(
                 target_mm: t.target.mm(),
                 reached_mm: reached,
                 error_mm: error,
-                within_tolerance: error.is_some_and(|e| e.abs() <= options.tolerance_mm + 1e-9),
+                within_tolerance: error
+                    .is_some_and(|e| e.abs() <= options.tolerance_mm + ROUNDING_MM),
                 settled_ms: settled.get(&t.id).copied(),
             }
         })
@@ -294,6 +295,15 @@ async fn sync<T: Transport>(
     Ok((duration, sent))
 }
 
+/// How often a move's progress is reported: 20 times a second looks smooth in a progress bar
+/// and costs nothing next to the bus.
+const PROGRESS_PERIOD: Duration = Duration::from_millis(50);
+
+/// Slack for rounding when a position is compared with its tolerance: positions and targets
+/// are whole hundredths of a mm, so their difference in `f64` may differ from the decimal
+/// value in the last bits; a millionth of a micrometre is far below anything the wire carries.
+const ROUNDING_MM: f64 = 1e-9;
+
 /// How many times targets and SYNC are resent when heartbeats do not confirm them.
 const CONFIRM_RETRIES: usize = 3;
 /// How long to wait for heartbeats confirming targets or SYNC: two and a half of the nodes'
@@ -322,7 +332,7 @@ fn position_mm<T: Transport>(session: &Session<T>, t: &PlannedTarget) -> Option<
 }
 
 fn within<T: Transport>(session: &Session<T>, t: &PlannedTarget, tolerance_mm: f64) -> bool {
-    position_mm(session, t).is_some_and(|p| (p - t.target.mm()).abs() <= tolerance_mm + 1e-9)
+    position_mm(session, t).is_some_and(|p| (p - t.target.mm()).abs() <= tolerance_mm + ROUNDING_MM)
 }
 
 /// Every actuator of `plan` is within tolerance and at rest (its node's heartbeat shows it

@@ -302,12 +302,21 @@ fn request_name(request: &Message) -> &'static str {
     }
 }
 
+/// How long to wait for an answer on a serial link before retrying: a pseudo-terminal or a
+/// USB adapter on a busy host answers in a few ms, plus the node's poll cycle; lenient.
+const SERIAL_ANSWER_TIMEOUT: Duration = Duration::from_millis(60);
+/// The same on CAN, where a node answers as soon as the frame arrives (1 Mbit/s: a frame
+/// takes about 0.13 ms); lenient for a busy host.
+const CAN_ANSWER_TIMEOUT: Duration = Duration::from_millis(30);
+/// The longest a wait sleeps between checks of its condition when no heartbeat or poll is
+/// due sooner.
+const CHECK_PERIOD: Duration = Duration::from_millis(10);
+
 /// How long to wait for an answer before retrying.
 fn answer_timeout(link: Link) -> Duration {
     match link {
-        // A pseudo-terminal or USB adapter on a busy host answers in a few ms; be lenient.
-        Link::Serial => Duration::from_millis(60),
-        _ => Duration::from_millis(30),
+        Link::Serial => SERIAL_ANSWER_TIMEOUT,
+        _ => CAN_ANSWER_TIMEOUT,
     }
 }
 
@@ -645,9 +654,8 @@ impl<T: Transport> Session<T> {
             if Instant::now() >= deadline {
                 return Ok(false);
             }
-            // Wake for the next heartbeat or poll, or at least every 10 ms to check.
-            let wake =
-                deadline.min(self.next_service).min(Instant::now() + Duration::from_millis(10));
+            // Wake for the next heartbeat or poll, or at least every check period.
+            let wake = deadline.min(self.next_service).min(Instant::now() + CHECK_PERIOD);
             self.receive_until(wake, |_| false).await?;
         }
     }

@@ -23,6 +23,7 @@ pub use rings::{RingFit, SHAPE_NOTE_MM, Saturation, region_of, ring_girth};
 
 use crate::profiles::Profiles;
 use crate::regions::Region;
+use crate::setpoints::SetPoints;
 use form_description::FormDescription;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -54,6 +55,13 @@ impl Fit {
             .map(|r| (r.ring.clone(), r.mannequin_girth_mm))
             .collect()
     }
+
+    /// The set-point file of the fit, with each ring's target girth
+    /// ([`Self::target_girths`]), so that a drive can tell whether the form took the shape.
+    pub fn setpoints(&self) -> SetPoints {
+        SetPoints::new(self.form.clone(), self.positions_mm.clone())
+            .with_target_girths(self.target_girths())
+    }
 }
 
 /// Why a fit could not be made.
@@ -80,6 +88,29 @@ pub fn regions_of(form: &FormDescription) -> Vec<Region> {
 
 /// Fits `form` to the mannequin of `profiles`: every actuator gets an extension within its
 /// stroke; mirror pairs get equal extensions.
+///
+/// ```
+/// use dressform::{fitting, mannequin::MannequinOptions, mesh::Mesh, pipeline, scan};
+/// use std::path::Path;
+///
+/// // A synthetic customer (1700 mm, chest 960, waist 800, hip 1000 mm) taken as a scan, and
+/// // the profiles of its symmetric mannequin.
+/// let surface = sim::capture::generate(&Default::default()).unwrap().surface;
+/// let body = Mesh::new(surface.positions.iter().map(|&p| p.into()).collect(), surface.triangles);
+/// let scan = scan::from_mesh(body, Path::new("customer"), &Default::default()).unwrap();
+/// let mannequin = pipeline::symmetrize(&scan, &MannequinOptions::default(), |_| {}).unwrap();
+///
+/// let form = form_description::reference();
+/// let fit = fitting::fit(&mannequin.profiles, &form).unwrap();
+/// for actuator in &form.actuators {
+///     let extension = fit.positions_mm[&actuator.id];
+///     assert!((0.0..=actuator.stroke_mm).contains(&extension)); // never beyond the stroke
+/// }
+/// // The waist ring takes the mannequin's girth there (within the 1 mm a mannequin's surface
+/// // is known to, and the panels' polygon).
+/// let waist = fit.rings.iter().find(|r| r.ring == "waist").unwrap();
+/// assert!((waist.form_girth_mm - waist.mannequin_girth_mm).abs() < 2.0);
+/// ```
 pub fn fit(profiles: &Profiles, form: &FormDescription) -> Result<Fit, FitError> {
     profiles.validate(&regions_of(form)).map_err(FitError::Invalid)?;
     let placement = Placement::new(profiles, form);

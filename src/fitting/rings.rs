@@ -123,7 +123,9 @@ const BRACKET_MARGIN_MM: f64 = 1.0;
 /// millimetre a denoised mannequin's surface is known to ([`SHAPE_NOTE_MM`]).
 const GIRTH_MATCHED_MM: f64 = 0.01;
 
-/// Fits one ring; returns its report and the extensions of its actuators.
+/// Fits one ring; returns its report and the extensions of its actuators. Steps: place the
+/// ring on the mannequin ([`Placement`]), take the mannequin's section there, then match its
+/// girth ([`Panels::match_girth`]); a ring with no section stays retracted.
 pub(super) fn fit_ring(
     profiles: &Profiles,
     form: &FormDescription,
@@ -137,49 +139,73 @@ pub(super) fn fit_ring(
     }
     let z = placement.mannequin_height(ring.height_mm);
     let centre = DVec2::from_array(ring.center_mm);
-    let mut report = RingFit {
-        ring: ring.name.clone(),
-        anchor: ring.anchor,
-        form_height_mm: ring.height_mm,
-        mannequin_height_mm: z,
-        offset_mm: ring.height_mm - z,
-        mannequin_girth_mm: 0.0,
-        form_girth_mm: 0.0,
-        largest_radial_gap_mm: 0.0,
-        saturated: Vec::new(),
-    };
-    let Some(section) = section_at(profiles, region_of(ring), z) else {
+    let mut report = RingFit::placed(ring, z);
+    let extensions = match section_at(profiles, region_of(ring), z) {
+        Some(section) => {
+            Panels::against(&section, centre, &actuators).match_girth(&section, &mut report)
+        }
         // No mannequin there (above the neck, below the legs): the ring stays retracted.
-        let zeros = vec![0.0; actuators.len()];
-        report.form_girth_mm = skin_girth(centre, &actuators, &zeros);
-        return Ok((report, actuators.iter().map(|a| (a.id.clone(), 0.0)).collect()));
+        None => {
+            let retracted = vec![0.0; actuators.len()];
+            report.form_girth_mm = skin_girth(centre, &actuators, &retracted);
+            retracted
+        }
     };
-    let directions: Vec<DVec2> =
-        actuators.iter().map(|a| DVec2::from_array(a.direction())).collect();
-    let panels = Panels { centre, reach: cast_along(&section, centre, &directions), actuators };
-    let target = section.tape_girth();
-    let delta = panels.offset_for_girth(target);
-    let extensions = panels.clamped(delta);
-    report.mannequin_girth_mm = target;
-    report.form_girth_mm = skin_girth(centre, &panels.actuators, &extensions);
-    report.largest_radial_gap_mm = panels.largest_gap(&extensions);
-    // Where the girth is matched, the excess is measured at the solution; where the girth is out
-    // of reach, at the shape targets themselves (no common offset).
-    let matched = (report.form_girth_mm - target).abs() < GIRTH_MATCHED_MM;
-    report.saturated = panels.saturations(if matched { delta } else { 0.0 });
-    let ids = panels.actuators.iter().map(|a| a.id.clone());
+    let ids = actuators.iter().map(|a| a.id.clone());
     Ok((report, ids.zip(extensions).collect()))
+}
+
+impl RingFit {
+    /// The report of `ring` placed at mannequin height `z`, before it is shaped: no girths,
+    /// no gap, nothing saturated.
+    fn placed(ring: &RingSpec, z: f64) -> Self {
+        RingFit {
+            ring: ring.name.clone(),
+            anchor: ring.anchor,
+            form_height_mm: ring.height_mm,
+            mannequin_height_mm: z,
+            offset_mm: ring.height_mm - z,
+            mannequin_girth_mm: 0.0,
+            form_girth_mm: 0.0,
+            largest_radial_gap_mm: 0.0,
+            saturated: Vec::new(),
+        }
+    }
 }
 
 /// A ring's panels against the mannequin's section: where each actuator's direction meets it.
 struct Panels<'a> {
     centre: DVec2,
-    actuators: Vec<&'a ActuatorSpec>,
+    actuators: &'a [&'a ActuatorSpec],
     /// Distance from the ring's axis to the section along each actuator's direction.
     reach: Vec<f64>,
 }
 
-impl Panels<'_> {
+impl<'a> Panels<'a> {
+    /// The panels of `actuators` around `centre`, against `section` (the farthest crossing
+    /// along each actuator's direction).
+    fn against(section: &Contour, centre: DVec2, actuators: &'a [&'a ActuatorSpec]) -> Self {
+        let directions: Vec<DVec2> =
+            actuators.iter().map(|a| DVec2::from_array(a.direction())).collect();
+        Panels { centre, reach: cast_along(section, centre, &directions), actuators }
+    }
+
+    /// The extensions whose skin takes the section's tape girth — girth first, shape second —
+    /// filling in `report`'s girths, largest gap and saturated actuators.
+    fn match_girth(&self, section: &Contour, report: &mut RingFit) -> Vec<f64> {
+        let target = section.tape_girth();
+        let delta = self.offset_for_girth(target);
+        let extensions = self.clamped(delta);
+        report.mannequin_girth_mm = target;
+        report.form_girth_mm = skin_girth(self.centre, self.actuators, &extensions);
+        report.largest_radial_gap_mm = self.largest_gap(&extensions);
+        // Where the girth is matched, the excess is measured at the solution; where the girth
+        // is out of reach, at the shape targets themselves (no common offset).
+        let matched = (report.form_girth_mm - target).abs() < GIRTH_MATCHED_MM;
+        report.saturated = self.saturations(if matched { delta } else { 0.0 });
+        extensions
+    }
+
     /// The extensions that put every panel on the section, moved out by `delta` (unclamped).
     fn raw(&self, delta: f64) -> Vec<f64> {
         self.actuators.iter().zip(&self.reach).map(|(a, r)| r - a.base_radius_mm + delta).collect()
@@ -188,13 +214,13 @@ impl Panels<'_> {
     /// [`raw`](Self::raw) within each actuator's stroke.
     fn clamped(&self, delta: f64) -> Vec<f64> {
         let raw = self.raw(delta);
-        raw.iter().zip(&self.actuators).map(|(e, a)| e.clamp(0.0, a.stroke_mm)).collect()
+        raw.iter().zip(self.actuators).map(|(e, a)| e.clamp(0.0, a.stroke_mm)).collect()
     }
 
     /// The common radial offset whose clamped extensions give the skin `target` girth
     /// (bisection); the bracket's end when the girth is out of reach.
     fn offset_for_girth(&self, target: f64) -> f64 {
-        let girth = |delta: f64| skin_girth(self.centre, &self.actuators, &self.clamped(delta));
+        let girth = |delta: f64| skin_girth(self.centre, self.actuators, &self.clamped(delta));
         // Bracket: below `lo` every panel is retracted, above `hi` every panel is at full stroke.
         let on_section =
             || self.actuators.iter().zip(&self.reach).map(|(a, r)| r - a.base_radius_mm);

@@ -7,7 +7,7 @@ pub mod frontal;
 pub mod quality;
 mod skip;
 
-pub use skip::or_skip;
+pub use skip::{or_skip, python_modules};
 
 /// The MakeHuman assets (`$DRESSFORM_MAKEHUMAN`, else `../shared/makehuman` beside the
 /// project), or `None` with a message when they are absent. With `DRESSFORM_REQUIRE_SHARED=1`

@@ -4,10 +4,16 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fmt;
 
 use firmware_protocol::actuator::MAX_ACTUATORS;
-use firmware_protocol::{NodeId, Position};
+use firmware_protocol::{HUNDREDTHS_PER_MM, NodeId, Position, TENTHS_PER_MM_S2};
 
 use super::description::{ActuatorSpec, BodyPart, FormDescription, FormSpec, RingSpec};
 
+/// Smallest stroke, mm: one step of the wire's positions (0.01 mm).
+const MIN_STROKE_MM: f64 = 1.0 / HUNDREDTHS_PER_MM;
+/// Smallest speed the wire carries above zero (0.01 mm/s), mm/s.
+const MIN_SPEED_MM_S: f64 = 1.0 / HUNDREDTHS_PER_MM;
+/// Smallest acceleration the wire carries above zero (0.1 mm/s²), mm/s².
+const MIN_ACCEL_MM_S2: f64 = 1.0 / TENTHS_PER_MM_S2;
 /// Largest speed the wire carries (`u16` in 0.01 mm/s), mm/s.
 const MAX_SPEED_MM_S: f64 = 655.35;
 /// Largest acceleration the wire carries (`u16` in 0.1 mm/s²), mm/s².
@@ -360,19 +366,19 @@ impl FormSpec {
                 (
                     "stroke_mm",
                     a.stroke_mm,
-                    a.stroke_mm >= 0.01 && a.stroke_mm <= max_stroke,
+                    a.stroke_mm >= MIN_STROKE_MM && a.stroke_mm <= max_stroke,
                     "in 0.01..=655.34",
                 ),
                 (
                     "max_speed_mm_s",
                     a.max_speed_mm_s,
-                    a.max_speed_mm_s >= 0.01 && a.max_speed_mm_s <= MAX_SPEED_MM_S,
+                    a.max_speed_mm_s >= MIN_SPEED_MM_S && a.max_speed_mm_s <= MAX_SPEED_MM_S,
                     "in 0.01..=655.35",
                 ),
                 (
                     "max_accel_mm_s2",
                     a.max_accel_mm_s2,
-                    a.max_accel_mm_s2 >= 0.1 && a.max_accel_mm_s2 <= MAX_ACCEL_MM_S2,
+                    a.max_accel_mm_s2 >= MIN_ACCEL_MM_S2 && a.max_accel_mm_s2 <= MAX_ACCEL_MM_S2,
                     "in 0.1..=6553.5",
                 ),
             ];

@@ -2,7 +2,7 @@
 //! panel it moves (which a jam or a broken encoder makes part ways with the plan).
 
 use firmware_protocol::update::shortest_duration_ms;
-use firmware_protocol::{Accel, Position, Speed};
+use firmware_protocol::{Accel, HUNDREDTHS_PER_MM, Position, Speed};
 use tokio::time::Instant;
 
 use super::motion::{Limits, Profile};
@@ -188,7 +188,7 @@ impl ActuatorSim {
         let fastest = Profile::fastest(p0, v0, p1, limits);
         let required_ms = if v0 == 0.0 {
             // From rest host and node share one integer formula.
-            let from = (p0 * 100.0).round().clamp(0.0, f64::from(u16::MAX)) as u16;
+            let from = (p0 * HUNDREDTHS_PER_MM).round().clamp(0.0, f64::from(u16::MAX)) as u16;
             let distance = target.hundredths_mm().abs_diff(from);
             let speed = Speed::from_hundredths_mm_s(self.params.max_speed);
             let accel = Accel::from_tenths_mm_s2(self.params.max_accel);
@@ -239,7 +239,7 @@ impl ActuatorSim {
 
     /// How far the panel lags the plan, 0.01 mm.
     pub fn following_error(&self, now: Instant) -> f64 {
-        (self.planned(now).0 - self.position(now)).abs() * 100.0
+        (self.planned(now).0 - self.position(now)).abs() * HUNDREDTHS_PER_MM
     }
 
     /// After a following error: the position is lost, the plan resets to where the panel is.
@@ -278,7 +278,7 @@ impl ActuatorSim {
             return None;
         }
         let max = f64::from(Position::MAX.hundredths_mm());
-        let hundredths = ((self.position(now) + noise) * 100.0).round().clamp(0.0, max);
+        let hundredths = ((self.position(now) + noise) * HUNDREDTHS_PER_MM).round().clamp(0.0, max);
         Position::new(hundredths as u16)
     }
 }

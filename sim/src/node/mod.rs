@@ -64,8 +64,8 @@ use firmware_protocol::message::{
 };
 use firmware_protocol::version::FirmwareVersion;
 use firmware_protocol::{
-    Accel, Actuator, ActuatorSet, Address, Code, Link, Message, NodeId, PROTOCOL_VERSION, Packet,
-    Position, ProtocolVersion, Speed,
+    Accel, Actuator, ActuatorSet, Address, Code, HUNDREDTHS_PER_MM, Link, Message, NodeId,
+    PROTOCOL_VERSION, Packet, Position, ProtocolVersion, Speed,
 };
 use rand::SeedableRng;
 use rand::rngs::ChaCha8Rng;
@@ -458,7 +458,7 @@ impl Node {
             if actuator.encoder_broken && !actuator.encoder_reported {
                 actuator.encoder_reported = true;
                 actuator.lose_position(now);
-                faults.push((index, (ENCODER_GLITCH_MM * 100.0) as i32));
+                faults.push((index, (ENCODER_GLITCH_MM * HUNDREDTHS_PER_MM) as i32));
             } else if powered
                 && actuator.following_error(now) > f64::from(actuator.params.following_error_limit)
             {

@@ -43,6 +43,15 @@ pub struct Profile {
 
 /// Bisection steps: halves a ±655 mm/s (or ±1000 s) interval below 1e-15.
 const BISECTIONS: usize = 64;
+/// The shortest first guess at a move's duration, s: a millisecond, the wire's unit of
+/// durations, so that a move of nothing from rest still brackets.
+const MIN_GUESS_S: f64 = 1e-3;
+/// The longest duration the bracket grows to, s: far beyond any move (the wire's durations
+/// end at 65.535 s); a guard against a loop that could not end on bad limits.
+const MAX_BRACKET_S: f64 = 1e9;
+/// Knot times closer than this are one, s: far below the node's 1 ms tick, above the
+/// rounding of sums of a few seconds in `f64`.
+const SAME_TIME_S: f64 = 1e-12;
 
 impl Profile {
     /// Standing still at `p`.
@@ -127,8 +136,9 @@ pub fn shortest_time(v0: f64, distance: f64, limits: Limits) -> f64 {
         return lo;
     }
     let mut lo = lo;
-    let mut hi = lo + (distance.abs() / limits.speed + 2.0 * limits.speed / limits.accel).max(1e-3);
-    while !feasible(hi) && hi < 1e9 {
+    let mut hi =
+        lo + (distance.abs() / limits.speed + 2.0 * limits.speed / limits.accel).max(MIN_GUESS_S);
+    while !feasible(hi) && hi < MAX_BRACKET_S {
         lo = hi;
         hi *= 2.0;
     }
@@ -169,7 +179,7 @@ fn knots(p0: f64, v0: f64, vc: f64, duration: f64, accel: f64) -> Vec<Knot> {
     ];
     times.retain(|t| (0.0..=t_end).contains(t));
     times.sort_by(f64::total_cmp);
-    times.dedup_by(|x, y| (*x - *y).abs() < 1e-12);
+    times.dedup_by(|x, y| (*x - *y).abs() < SAME_TIME_S);
     let mut knots: Vec<Knot> = Vec::with_capacity(times.len());
     for t in times {
         // Start at v0 exactly, and end at rest exactly.

@@ -19,6 +19,9 @@ use super::TransportError;
 /// How long a read waits before the reader checks whether it should stop; also the longest a
 /// write waits for a device that does not take its bytes.
 const READ_TIMEOUT: Duration = Duration::from_millis(10);
+/// The most bytes one read takes from the device: at 1 Mbaud about 10 ms of traffic, what
+/// arrives within one [`READ_TIMEOUT`].
+const READ_CHUNK: usize = 1024;
 
 /// The reading side of an open serial device: its reader thread.
 pub struct Line {
@@ -55,7 +58,7 @@ impl Line {
         let reader = std::thread::Builder::new()
             .name(format!("dressform reader {device}"))
             .spawn(move || {
-                let mut buf = [0u8; 1024];
+                let mut buf = [0u8; READ_CHUNK];
                 let mut parsed = Vec::new();
                 while !stopping.load(Ordering::Relaxed) {
                     match reader.read(&mut buf) {

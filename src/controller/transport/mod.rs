@@ -8,7 +8,7 @@
 //! | slcan (Lawicel USB-CAN adapter) on a serial port | [`slcan::Slcan`] | `tIIILDD..\r` text, classic CAN only | cyclically (CAN) |
 //! | SocketCAN interface | [`socketcan::SocketCan`] | kernel CAN frames, classic CAN | cyclically (CAN) |
 //!
-//! Every link sends through its [`Gate`]: the e-stop path (see [`crate::controller::estop`]).
+//! Every link sends through its [`Gate`]: the e-stop path (see [`gate`]).
 //!
 //! Packet handling: a received frame that does not decode (bad CRC, unknown code, invalid
 //! field, an extended or remote CAN frame) is dropped and counted, never an error; only the
@@ -98,8 +98,8 @@ pub enum LinkSpec {
     Can(String),
 }
 
-/// Any of the hardware links, opened from a [`LinkSpec`] (the simulated form is started by
-/// [`crate::controller::simulated`], which owns its bus).
+/// Any of the links. Hardware links open from a [`LinkSpec`] here; the simulated bus needs a
+/// simulated form on it ([`crate::controller::open::OpenLink`] opens either).
 #[derive(Debug)]
 pub enum Connection {
     /// A serial port.

@@ -1,0 +1,68 @@
+//! What the commands write: a pipeline result as its set of files, by name and content.
+//! [`crate::output`] commits such a set into a directory, all or nothing.
+//!
+//! | file | what |
+//! |---|---|
+//! | `mannequin.<ext>` | the mannequin, as the [`Export`] says (format, units, axes, frame) |
+//! | [`PROFILES`] | its sections ([`crate::profiles`]), what a form is fitted to |
+//! | [`MEASUREMENTS`] | Table 1 and Fig. 11 ([`crate::measure::Comparison`]) |
+//! | [`SETPOINTS`] | with a form: the set-points ([`crate::setpoints`]) |
+//! | [`PREVIEW`] | the scan and the mannequin in three views |
+//! | [`SECTIONS`] | the chest, waist and hip sections of both (paper Fig. 9 and 11) |
+
+use crate::output::OutputSet;
+use crate::pipeline::Symmetrized;
+use crate::preview::{preview_png, sections_svg};
+use crate::scan::Scan;
+use crate::scan::format::Export;
+use crate::setpoints::SetPoints;
+
+/// The mannequin's file name without its extension (the export adds it).
+pub const MANNEQUIN: &str = "mannequin";
+/// The mannequin's profiles.
+pub const PROFILES: &str = "profiles.json";
+/// The measurements of the scan and the mannequin.
+pub const MEASUREMENTS: &str = "measurements.json";
+/// The form's set-points.
+pub const SETPOINTS: &str = "setpoints.json";
+/// The picture of the scan and the mannequin.
+pub const PREVIEW: &str = "preview.png";
+/// The picture of the sections.
+pub const SECTIONS: &str = "sections.svg";
+
+/// The files of a mannequin made from a scan (`symmetrize`), with the form's set-points when
+/// a form was fitted to it (`run`, `demo`).
+#[derive(Debug, Clone, Copy)]
+pub struct Outputs<'a> {
+    result: &'a Symmetrized,
+    scan: &'a Scan,
+    export: &'a Export,
+    setpoints: Option<&'a SetPoints>,
+}
+
+impl<'a> Outputs<'a> {
+    /// The files of `result`, the mannequin of `scan`, its own file written as `export` says.
+    pub fn of(result: &'a Symmetrized, scan: &'a Scan, export: &'a Export) -> Self {
+        Outputs { result, scan, export, setpoints: None }
+    }
+
+    /// With the set-points of a form fitted to the mannequin.
+    pub fn with_setpoints(self, setpoints: &'a SetPoints) -> Self {
+        Outputs { setpoints: Some(setpoints), ..self }
+    }
+
+    /// The set of files (see the module documentation).
+    pub fn files(&self) -> Result<OutputSet, serde_json::Error> {
+        let (result, scan) = (self.result, self.scan);
+        let mut set = OutputSet::new();
+        set.add(self.export.file_name(MANNEQUIN), result.mannequin_file(self.export, &scan.frame));
+        set.add(PROFILES, serde_json::to_vec_pretty(&result.profiles)?);
+        set.add(MEASUREMENTS, serde_json::to_vec_pretty(&result.comparison)?);
+        if let Some(setpoints) = self.setpoints {
+            set.add(SETPOINTS, setpoints.to_json_string());
+        }
+        set.add(PREVIEW, preview_png(&[(&scan.body, "scan")], result));
+        set.add(SECTIONS, sections_svg(&scan.body, result));
+        Ok(set)
+    }
+}
