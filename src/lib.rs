@@ -7,6 +7,8 @@
 //! - [`scan`]: reading OBJ/PLY/STL, validation and cleaning, the canonical body frame;
 //! - [`slice`]: horizontal cross-sections and their girths;
 //! - [`regions`]: body regions and landmarks (crotch, armpits, neck) from tracked slices;
+//! - [`segmented_body`]: a body segmented once, and its (cached) sections: what `measure`,
+//!   `mannequin` and the comparisons take;
 //! - [`symmetry`]: axial (torso) and bilateral (legs) symmetry of sections, girth preserved;
 //! - [`fit`]: the body model fitted to a scan (eq. 4): pose and shape, robust ICP with LM;
 //! - [`fitting`]: the robotic form's rings placed on the mannequin, set-points, fidelity;
@@ -49,6 +51,7 @@ pub mod report;
 pub mod rig_transfer;
 pub mod safety;
 pub mod scan;
+pub mod segmented_body;
 pub mod setpoints;
 pub mod skinning;
 pub mod slice;

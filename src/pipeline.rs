@@ -11,11 +11,12 @@ use crate::fitting::{self, Fit, FitError, region_of, regions_of};
 use crate::mannequin::{self, Mannequin, MannequinError, MannequinOptions};
 use crate::measure::{Comparison, compare, levels};
 use crate::profiles::Profiles;
-use crate::regions::{BodyRegions, TRACKING_STEP_MM};
+use crate::regions::BodyRegions;
 use crate::scan::Scan;
 use crate::scan::carried::CarriedBody;
 use crate::scan::format::Export;
 use crate::scan::frame::CanonicalFrame;
+use crate::segmented_body::SegmentedBody;
 use crate::setpoints::SetPoints;
 
 /// A scan's symmetric mannequin with its segmentation, measurements and profiles.
@@ -58,15 +59,23 @@ pub fn symmetrize(
     mut progress: impl FnMut(usize),
 ) -> Result<Symmetrized, MannequinError> {
     progress(0);
-    let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM)?;
+    let body = SegmentedBody::find(&scan.body)?;
+    symmetrize_segmented(&body, options, progress)
+}
+
+/// [`symmetrize`] from the segmented body on: the steps after the first.
+fn symmetrize_segmented(
+    body: &SegmentedBody,
+    options: &MannequinOptions,
+    mut progress: impl FnMut(usize),
+) -> Result<Symmetrized, MannequinError> {
     progress(1);
-    let levels = levels(&scan.body, &regions);
-    let mannequin =
-        mannequin::build(&scan.body, &regions, &[levels.chest, levels.waist, levels.hip], options)?;
+    let levels = levels(body);
+    let mannequin = mannequin::build(body, &[levels.chest, levels.waist, levels.hip], options)?;
     progress(2);
-    let comparison = compare(&scan.body, &regions, &levels, &mannequin);
+    let comparison = compare(body, &levels, &mannequin);
     let profiles = Profiles::of(&mannequin, &comparison.levels);
-    Ok(Symmetrized { regions, mannequin, comparison, profiles })
+    Ok(Symmetrized { regions: body.regions().clone(), mannequin, comparison, profiles })
 }
 
 /// A scan's mannequin with a form fitted to it: what `run` and `demo` drive the form to.
@@ -118,22 +127,19 @@ pub fn shape(
     form: &FormDescription,
     mut progress: impl FnMut(usize),
 ) -> Result<Shaped, ShapeError> {
-    let symmetrized = symmetrize(scan, options, &mut progress)?;
+    progress(0);
+    let body = SegmentedBody::find(&scan.body).map_err(MannequinError::from)?;
+    let symmetrized = symmetrize_segmented(&body, options, &mut progress)?;
     progress(STEPS.len());
     let fit = fitting::fit(&symmetrized.profiles, form)?;
     let setpoints = fit.setpoints();
-    let rings = ring_girths(scan, &symmetrized, form, &fit);
+    let rings = ring_girths(&body, form, &fit);
     Ok(Shaped { symmetrized, fit, setpoints, rings })
 }
 
-/// The scan's and the mannequin's girths at every ring of `form` as `fit` placed them: the
-/// scan is cut once per region, at the heights of all the rings shaping it.
-fn ring_girths(
-    scan: &Scan,
-    symmetrized: &Symmetrized,
-    form: &FormDescription,
-    fit: &Fit,
-) -> Vec<RingGirths> {
+/// The scan's (`body`'s) and the mannequin's girths at every ring of `form` as `fit` placed
+/// them: the scan is cut once per region, at the heights of all the rings shaping it.
+fn ring_girths(body: &SegmentedBody, form: &FormDescription, fit: &Fit) -> Vec<RingGirths> {
     let mut scanned: BTreeMap<&str, Option<f64>> = BTreeMap::new();
     for region in regions_of(form) {
         let rings: Vec<(&str, f64)> = form
@@ -144,7 +150,7 @@ fn ring_girths(
             .map(|(ring, r)| (ring.name.as_str(), r.mannequin_height_mm))
             .collect();
         let heights: Vec<f64> = rings.iter().map(|r| r.1).collect();
-        let sections = symmetrized.regions.sections_of(&scan.body, region, &heights);
+        let sections = body.sections_of(region, &heights);
         for (&(name, _), section) in rings.iter().zip(sections) {
             scanned.insert(name, section.map(|c| c.tape_girth()));
         }

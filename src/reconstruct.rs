@@ -10,9 +10,9 @@ use crate::mannequin::{MannequinError, MannequinOptions};
 use crate::measure::{Girth, Measurements, levels, measure_at};
 use crate::pipeline::{self, Symmetrized};
 use crate::pose_symmetry::{self, PoseOverrides};
-use crate::regions::{BodyRegions, TRACKING_STEP_MM};
 use crate::rig_transfer::{self, RigTransfer};
 use crate::scan::Scan;
+use crate::segmented_body::SegmentedBody;
 use glam::DVec3;
 use serde::Serialize;
 
@@ -115,9 +115,8 @@ pub fn reconstruct(
     posed.frame.centre_on_torso(&mut posed.body);
 
     let result = pipeline::symmetrize(&posed, &options.mannequin, |s| progress(STEPS.len() + s))?;
-    let scan_measurements = BodyRegions::find(body, TRACKING_STEP_MM)
-        .ok()
-        .map(|regions| measure_at(body, &regions, &levels(body, &regions)));
+    let scan_measurements =
+        SegmentedBody::find(body).ok().map(|body| measure_at(&body, &levels(&body)));
     Ok(Reconstruction {
         model: extended,
         fit: fitted,

@@ -17,6 +17,7 @@ use dressform::mesh::{Mesh, smooth::DEFAULT_PASSES};
 use dressform::pipeline::{Symmetrized, symmetrize};
 use dressform::regions::Region;
 use dressform::scan::{self, Scan, format::Format, frame::FrameOptions};
+use dressform::segmented_body::SegmentedBody;
 use glam::DVec3;
 use rayon::prelude::*;
 use sim::capture::{Artifacts, BodyParams, Pose, SyntheticBody, capture, generate};
@@ -236,7 +237,8 @@ fn report(case: &Case, out: &Symmetrized) -> Report {
     let m = &out.mannequin;
     let lm = &m.landmarks;
     let heights: Vec<f64> = m.torso.iter().map(|l| l.z).collect();
-    let input = out.regions.torso_sections(&case.scan.body, &heights);
+    let scan = SegmentedBody::with_regions(&case.scan.body, &out.regions);
+    let input = scan.torso_sections(&heights);
     let ours = dressform::measure::central_loops(&m.mesh, m.axis, &heights);
     // Below the shoulder cap every layer keeps its section's girth; within it the mesh's
     // rings are bent over the shoulders, and its horizontal sections are reported.
@@ -265,7 +267,7 @@ fn report(case: &Case, out: &Symmetrized) -> Report {
         w.windows(2).map(|p| (p[1] - p[0]).abs()).fold(0.0, f64::max)
     };
     let shoulder_jump = (
-        largest_jump(&out.regions.torso_sections(&case.scan.body, &above)),
+        largest_jump(&scan.torso_sections(&above)),
         width_jump(&m.mesh, shoulders, f64::INFINITY).0,
     );
     let band = (lm.crotch, lm.crotch + CROTCH_BAND_MM);
@@ -280,7 +282,7 @@ fn report(case: &Case, out: &Symmetrized) -> Report {
     });
     let leg_heights: Vec<f64> = m.left_leg.iter().map(|l| l.z).collect();
     let input_leg = |region| {
-        let sections = out.regions.sections_of(input_body, region, &leg_heights);
+        let sections = scan.sections_of(region, &leg_heights);
         let centres: Vec<(f64, f64)> = leg_heights
             .iter()
             .zip(&sections)

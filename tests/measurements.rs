@@ -16,8 +16,8 @@ use dressform::measure::{
 };
 use dressform::output::write_atomically;
 use dressform::regions::Landmarks;
-use dressform::regions::{BodyRegions, TRACKING_STEP_MM};
 use dressform::scan::format::Format;
+use dressform::segmented_body::SegmentedBody;
 use dressform::slice::Contour;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -221,10 +221,10 @@ fn the_measurement_set_matches_what_the_generator_knows() {
         .flat_map(|&seed| {
             let body = generate(&BodyParams::random(seed)).unwrap();
             let mesh = mesh_of(&body);
-            let regions = BodyRegions::find(&mesh, TRACKING_STEP_MM).unwrap();
-            let lv = levels(&mesh, &regions);
-            let d = dimensions(&mesh, &regions, &lv);
-            let m = &regions.landmarks;
+            let segmented = SegmentedBody::find(&mesh).unwrap();
+            let lv = levels(&segmented);
+            let d = dimensions(&segmented, &lv);
+            let m = segmented.landmarks();
             // Bilateral values of a body standing symmetrically agree side to side.
             for b in [d.thigh_girth_mm, d.knee_girth_mm, d.calf_girth_mm, d.ankle_girth_mm] {
                 assert!((b.left - b.right - b.difference).abs() < 1e-9);
@@ -240,10 +240,9 @@ fn the_measurement_set_matches_what_the_generator_knows() {
                 // Neck to waist: longer than the straight rise, shorter than half the stature.
                 assert!(w > m.neck - lv.waist && w < 0.5 * m.height, "seed {seed}: {w}");
             }
-            let upper =
-                neck_and_shoulders(&mesh, &regions).expect("the neck and shoulders are found");
-            let under_z = underbust(&mesh, &regions, &lv).expect("an underbust").z;
-            compare(&body, &d, &arms(&mesh, &regions), m.crotch, m.neck, (&upper, m), under_z)
+            let upper = neck_and_shoulders(&segmented).expect("the neck and shoulders are found");
+            let under_z = underbust(&segmented, &lv).expect("an underbust").z;
+            compare(&body, &d, &arms(&segmented), m.crotch, m.neck, (&upper, m), under_z)
                 .into_iter()
                 .map(|(n, a, b)| (seed, n, a, b))
                 .collect::<Vec<_>>()
@@ -353,8 +352,7 @@ fn a_level_taken_from_a_proportion_is_reported() {
     assert!(barrel.waist_girth_mm > barrel.hip_girth_mm, "a barrel: {barrel:?}");
     let notes = |p: &BodyParams| {
         let mesh = mesh_of(&generate(p).unwrap());
-        let regions = BodyRegions::find(&mesh, TRACKING_STEP_MM).unwrap();
-        find_levels(&mesh, &regions).fallbacks
+        find_levels(&SegmentedBody::find(&mesh).unwrap()).fallbacks
     };
     let (with_waist, without) = (notes(&shaped), notes(&barrel));
     println!("shaped: {with_waist:?}\nbarrel: {without:?}");
@@ -372,8 +370,8 @@ fn a_level_taken_from_a_proportion_is_reported() {
 fn the_underbust_is_the_fold_under_the_bust_even_below_a_chest_level_at_the_armpits() {
     let Some(dir) = common::makehuman() else { return };
     let scan = dressform::scan::load(&dir.join("base.obj"), &Default::default()).unwrap();
-    let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM).unwrap();
-    let d = dimensions(&scan.body, &regions, &levels(&scan.body, &regions));
+    let segmented = SegmentedBody::find(&scan.body).unwrap();
+    let d = dimensions(&segmented, &levels(&segmented));
     eprintln!("chest {:.1} mm, underbust {:.1} mm", d.chest_girth_mm, d.underbust_girth_mm);
     assert!(d.underbust_girth_mm < d.chest_girth_mm, "{d:?}");
 }

@@ -14,7 +14,7 @@ use dressform::makehuman::{MakeHuman, Pose};
 use dressform::measure::{central_loops, levels};
 use dressform::mesh::Mesh;
 use dressform::reconstruct::{ReconstructOptions, reconstruct};
-use dressform::regions::{BodyRegions, TRACKING_STEP_MM};
+use dressform::segmented_body::SegmentedBody;
 use glam::{DQuat, DVec3};
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
@@ -360,8 +360,7 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         let truth_path = tmp.path().join(format!("truth_scan{i}.obj"));
         write_obj(&truth, &truth_path);
         let truth = load(&truth_path);
-        let regions = BodyRegions::find(&truth.body, TRACKING_STEP_MM).unwrap();
-        let at = levels(&truth.body, &regions);
+        let at = levels(&SegmentedBody::find(&truth.body).unwrap());
         let heights = [at.chest, at.waist, at.hip];
         let girth_want = girths(&truth.body, &heights);
         let girth_got = girths(&rec.posed.body, &heights);
@@ -499,8 +498,7 @@ fn reconstruct_straightens_the_sim_generators_asymmetric_bodies() {
     pose.head_turn_deg = 20.0;
     poses.push(("left arm +10, spine bent 5 and twisted 8, head turned 20", pose));
     let reference = scanned(&BodyParams::default(), "a_pose");
-    let regions = BodyRegions::find(&reference.body, TRACKING_STEP_MM).unwrap();
-    let at = levels(&reference.body, &regions);
+    let at = levels(&SegmentedBody::find(&reference.body).unwrap());
     let mut misses = Vec::new();
     for (what, pose) in poses {
         let scan = scanned(&BodyParams { pose, ..BodyParams::default() }, "posed");

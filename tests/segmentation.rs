@@ -5,9 +5,9 @@
 use crate::common;
 
 use common::{makehuman, mesh_of};
-use dressform::mesh::Mesh;
-use dressform::regions::{Armhole, BodyRegions, TRACKING_STEP_MM};
+use dressform::regions::Armhole;
 use dressform::scan::{self, frame::FrameOptions};
+use dressform::segmented_body::SegmentedBody;
 use glam::DVec3;
 use sim::capture::{BodyParams, Pose, generate};
 
@@ -25,13 +25,13 @@ struct TorsoShape {
     reach: [f64; 2],
 }
 
-fn torso_shape(body: &Mesh, regions: &BodyRegions) -> TorsoShape {
-    let m = &regions.landmarks;
+fn torso_shape(body: &SegmentedBody) -> TorsoShape {
+    let m = body.landmarks();
     let lo = m.left_armpit.min(m.right_armpit) - 30.0;
     let hi = m.left_armhole.shoulder_point.z.max(m.right_armhole.shoulder_point.z);
     let count = ((hi - lo) / JUMP_STEP_MM) as usize;
     let zs: Vec<f64> = (0..count).map(|k| lo + JUMP_STEP_MM * k as f64).collect();
-    let loops = regions.torso_sections(body, &zs);
+    let loops = body.torso_sections(&zs);
     let half_widths: Vec<(f64, [f64; 2])> = zs
         .iter()
         .zip(&loops)
@@ -107,9 +107,8 @@ const SHOULDER_Z_TOLERANCE_MM: f64 = 25.0;
 fn check_generated(name: &str, params: &BodyParams) -> [f64; 4] {
     let body = generate(params).unwrap_or_else(|e| panic!("{name}: {e}"));
     let mesh = mesh_of(&body);
-    let regions =
-        BodyRegions::find(&mesh, TRACKING_STEP_MM).unwrap_or_else(|e| panic!("{name}: {e}"));
-    let m = &regions.landmarks;
+    let segmented = SegmentedBody::find(&mesh).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let m = segmented.landmarks();
     let lm = &body.truth.landmarks;
     let mut worst = [0.0f64; 4];
     for (side, a, truth) in
@@ -139,7 +138,7 @@ fn check_generated(name: &str, params: &BodyParams) -> [f64; 4] {
             (a.armpit.z - if side == "left" { m.left_armpit } else { m.right_armpit }).abs() < 1e-9
         );
     }
-    let shape = torso_shape(&mesh, &regions);
+    let shape = torso_shape(&segmented);
     println!(
         "{name}: width jump {:.1} mm at z = {:.0}; torso reaches {:.1} / {:.1} mm out above the armpits (acromions at {:.1} / {:.1})",
         shape.jump.0,
@@ -200,8 +199,8 @@ fn armholes_of_generated_bodies_in_the_a_pose_and_asymmetric() {
 fn armholes_of_the_makehuman_body_are_mirror_images() {
     let Some(dir) = makehuman() else { return };
     let scan = scan::load(&dir.join("base.obj"), &FrameOptions::default()).unwrap();
-    let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM).unwrap();
-    let m = &regions.landmarks;
+    let segmented = SegmentedBody::find(&scan.body).unwrap();
+    let m = segmented.landmarks();
     describe("makehuman", "left", &m.left_armhole);
     describe("makehuman", "right", &m.right_armhole);
     let mirror = |p: DVec3| DVec3::new(2.0 * m.centre_x - p.x, p.y, p.z);
@@ -221,7 +220,7 @@ fn armholes_of_the_makehuman_body_are_mirror_images() {
     println!("makehuman: left shoulder joint ({:.1}, {:.1}, {:.1})", joint.x, joint.y, joint.z);
     let (out, up) = (l.shoulder_point.x - joint.x, l.shoulder_point.z - joint.z);
     assert!((10.0..40.0).contains(&out) && (20.0..60.0).contains(&up), "{out:.1} out, {up:.1} up");
-    let shape = torso_shape(&scan.body, &regions);
+    let shape = torso_shape(&segmented);
     println!(
         "makehuman: width jump {:.1} mm at z = {:.0}; reach {:.1} / {:.1}",
         shape.jump.0, shape.jump.1, shape.reach[0], shape.reach[1]

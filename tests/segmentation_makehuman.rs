@@ -13,8 +13,9 @@ use dressform::mannequin::MannequinOptions;
 use dressform::measure::{Measurements, levels, measure_at};
 use dressform::mesh::Mesh;
 use dressform::pipeline::symmetrize;
-use dressform::regions::{BodyRegions, TRACKING_STEP_MM};
+use dressform::regions::Landmarks;
 use dressform::scan::{self, Scan};
+use dressform::segmented_body::SegmentedBody;
 use glam::DVec3;
 use rayon::prelude::*;
 use sim::capture::{TriangleSurface, with_noise_and_holes};
@@ -91,11 +92,11 @@ fn as_scan(mesh: Mesh, name: &str) -> Result<Scan, String> {
     Ok(scan)
 }
 
-fn measured(scan: &Scan) -> Result<(BodyRegions, Measurements), String> {
-    let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM)
-        .map_err(|e| format!("{}: {e}", scan.source.display()))?;
-    let m = measure_at(&scan.body, &regions, &levels(&scan.body, &regions));
-    Ok((regions, m))
+fn measured(scan: &Scan) -> Result<(Landmarks, Measurements), String> {
+    let body =
+        SegmentedBody::find(&scan.body).map_err(|e| format!("{}: {e}", scan.source.display()))?;
+    let m = measure_at(&body, &levels(&body));
+    Ok((*body.landmarks(), m))
 }
 
 /// The vertex of `mesh` nearest to `p`.
@@ -121,7 +122,7 @@ fn check(mh: &MakeHuman, seed: u64) -> Result<Changes, String> {
     let body = mh.shaped(&named).map_err(|e| e.to_string())?;
     let rest = mh.base.skin(&body);
     let rest_scan = as_scan(rest.clone(), &format!("seed {seed} un-posed"))?;
-    let (rest_regions, truth) = measured(&rest_scan)?;
+    let (rest_landmarks, truth) = measured(&rest_scan)?;
 
     // Holes where a scanner leaves them: at the armpits and crotch the un-posed body's
     // landmarks pick skin vertices, followed into the pose; the soles are each foot's lowest.
@@ -129,7 +130,7 @@ fn check(mh: &MakeHuman, seed: u64) -> Result<Changes, String> {
         mh.base.skin(&mh.pose(&body, &slightly_asymmetric(seed)).map_err(|e| e.to_string())?);
     // The scan's frame moves the body by a translation only (same units, axes and facing).
     let to_mesh = rest_scan.body.bounds().unwrap().min - rest.bounds().unwrap().min;
-    let lm = &rest_regions.landmarks;
+    let lm = &rest_landmarks;
     // The crotch: the lowest skin vertex on the centre line (the feet are far beside it).
     let on_centre_line = |p: &&DVec3| (p.x + to_mesh.x - lm.centre_x).abs() < CENTRE_LINE_MM;
     let crotch = rest.positions.iter().filter(on_centre_line).min_by(|a, b| a.z.total_cmp(&b.z));

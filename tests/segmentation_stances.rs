@@ -8,7 +8,8 @@
 
 use crate::common::{mesh_of, uniform};
 use dressform::measure::{levels, measure_at};
-use dressform::regions::{Armhole, BodyRegions, TRACKING_STEP_MM};
+use dressform::regions::Armhole;
+use dressform::segmented_body::SegmentedBody;
 use glam::DVec3;
 use rayon::prelude::*;
 use sim::capture::{BodyParams, generate};
@@ -98,10 +99,9 @@ fn check(stance: Stance, seed: u64) -> Result<Outcome, String> {
     let params = stance.params(seed);
     let body = generate(&params).map_err(|e| format!("seed {seed}: generator: {e}"))?;
     let mesh = mesh_of(&body);
-    let regions =
-        BodyRegions::find(&mesh, TRACKING_STEP_MM).map_err(|e| format!("seed {seed}: {e}"))?;
-    let lv = levels(&mesh, &regions);
-    let m = measure_at(&mesh, &regions, &lv);
+    let segmented = SegmentedBody::find(&mesh).map_err(|e| format!("seed {seed}: {e}"))?;
+    let lv = levels(&segmented);
+    let m = measure_at(&segmented, &lv);
     let t = &body.truth;
     let errors = [
         (m.chest.tape - t.chest.tape_girth_mm, "chest"),
@@ -112,7 +112,7 @@ fn check(stance: Stance, seed: u64) -> Result<Outcome, String> {
         errors.into_iter().max_by(|a, b| a.0.abs().total_cmp(&b.0.abs())).expect("three");
 
     // Arm material: torso sections every 10 mm from the crotch to the neck.
-    let lm = &regions.landmarks;
+    let lm = segmented.landmarks();
     let truth_plate = |s: &sim::capture::SideLandmarks, side: f64| {
         Armhole::through(
             DVec3::from_array(s.armpit),
@@ -125,7 +125,7 @@ fn check(stance: Stance, seed: u64) -> Result<Outcome, String> {
     let zs: Vec<f64> =
         (0..).map(|k| lm.crotch + 5.0 + 10.0 * k as f64).take_while(|&z| z < lm.neck).collect();
     let mut arm_material = (f64::MIN, 0.0);
-    for (z, c) in zs.iter().zip(regions.torso_sections(&mesh, &zs)) {
+    for (z, c) in zs.iter().zip(segmented.torso_sections(&zs)) {
         let c = c.ok_or_else(|| format!("seed {seed}: no torso at z = {z:.0}"))?;
         let below_both = plates.iter().all(|plate| *z <= plate.armpit.z);
         for p in &c.points {

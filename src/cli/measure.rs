@@ -5,8 +5,9 @@ use super::{Failure, FrameArgs, SmoothArgs, warn};
 use dressform::measure::{
     BodyDimensions, Girth, Levels, Measurements, dimensions, find_levels, measure_at, warnings,
 };
-use dressform::regions::{BodyRegions, Landmarks, TRACKING_STEP_MM};
+use dressform::regions::Landmarks;
 use dressform::scan;
+use dressform::segmented_body::SegmentedBody;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -77,31 +78,35 @@ fn measure_one(path: &Path, args: &MeasureArgs) -> Result<MeasureOut, Failure> {
     for w in scan.cleaning.warnings() {
         warn(&file, &w);
     }
-    let (regions, levels, fallbacks) = match scan.carried {
-        // A mannequin dressform made: measured as it is (it has no scanner noise to smooth
-        // away), at the levels and with the landmarks its file carries.
-        Some(carried) => (BodyRegions::armless(carried.landmarks), carried.levels, Vec::new()),
+    // A mannequin dressform made is measured as it is (it has no scanner noise to smooth
+    // away), at the levels and with the landmarks its file carries.
+    if scan.carried.is_none() {
+        scan.body.taubin_smooth(args.smooth.smooth);
+    }
+    let (body, levels, fallbacks) = match scan.carried {
+        Some(carried) => {
+            (SegmentedBody::armless(&scan.body, carried.landmarks), carried.levels, Vec::new())
+        }
         None => {
-            scan.body.taubin_smooth(args.smooth.smooth);
-            let regions = BodyRegions::find(&scan.body, TRACKING_STEP_MM)
+            let body = SegmentedBody::find(&scan.body)
                 .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
-            let found = find_levels(&scan.body, &regions);
-            (regions, found.levels, found.fallbacks)
+            let found = find_levels(&body);
+            (body, found.levels, found.fallbacks)
         }
     };
-    let measurements = measure_at(&scan.body, &regions, &levels);
-    let dimensions = dimensions(&scan.body, &regions, &levels);
+    let measurements = measure_at(&body, &levels);
+    let dimensions = dimensions(&body, &levels);
     let mut warnings = warnings(&scan.body, &levels);
     warnings.extend(fallbacks);
-    let at = regions
-        .torso_sections(&scan.body, &args.at)
+    let at = body
+        .torso_sections(&args.at)
         .into_iter()
         .zip(&args.at)
         .map(|(l, &z)| l.map(|c| Girth { z, tape: c.tape_girth(), contour: c.perimeter() }))
         .collect();
     Ok(MeasureOut {
         file,
-        landmarks: regions.landmarks,
+        landmarks: *body.landmarks(),
         levels,
         measurements,
         dimensions,

@@ -1,9 +1,9 @@
 //! `dressform slice <mesh> --heights 900,950,... [--json]`.
 
 use super::{Failure, FrameArgs, warn};
-use dressform::regions::{BodyRegions, Region, TRACKING_STEP_MM};
+use dressform::regions::Region;
 use dressform::scan;
-use dressform::slice::sections;
+use dressform::segmented_body::SegmentedBody;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -58,14 +58,16 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
     for w in scan.cleaning.warnings() {
         warn(&file, &w);
     }
-    let (regions, sections) = match scan.carried {
+    let (body, sections) = match scan.carried {
         // A mannequin dressform made: labelled by the landmarks its file carries.
         Some(carried) => {
-            (Ok(BodyRegions::armless(carried.landmarks)), sections(&scan.body, &args.heights))
+            let body = SegmentedBody::armless(&scan.body, carried.landmarks);
+            let sections = body.sections(&args.heights);
+            (Ok(body), sections)
         }
-        None => BodyRegions::find_and_cut(&scan.body, TRACKING_STEP_MM, &args.heights),
+        None => SegmentedBody::find_and_cut(&scan.body, &args.heights),
     };
-    let regions = regions.map_err(|e| warn(&file, &format!("loops are not labelled: {e}"))).ok();
+    let body = body.map_err(|e| warn(&file, &format!("loops are not labelled: {e}"))).ok();
     for s in sections.iter().filter(|s| s.bridged_gaps > 0) {
         warn(
             &file,
@@ -80,7 +82,7 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
         sections: sections
             .into_par_iter()
             .map(|s| {
-                let labels = regions.as_ref().map(|r| r.label(&s));
+                let labels = body.as_ref().map(|b| b.regions().label(&s));
                 SectionOut {
                     z_mm: s.height,
                     bridged_gaps: s.bridged_gaps,

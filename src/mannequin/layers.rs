@@ -1,9 +1,9 @@
 //! Cutting the torso and legs into layers and making each symmetric.
 
 use super::{Layer, MannequinError, MannequinOptions};
-use crate::mesh::Mesh;
-use crate::regions::{BodyRegions, Region, largest_with};
-use crate::slice::{Contour, sections};
+use crate::regions::{Region, largest_with};
+use crate::segmented_body::SegmentedBody;
+use crate::slice::Contour;
 use crate::symmetry::{axial, bilateral};
 use glam::DVec2;
 
@@ -41,12 +41,11 @@ pub(super) struct SymmetricLayers {
 /// The symmetry axis and the symmetric torso, left-leg and right-leg layers; the torso layers
 /// nearest to `keep` heights (the measurement levels) are moved onto them.
 pub(super) fn symmetric_layers(
-    body: &Mesh,
-    regions: &BodyRegions,
+    body: &SegmentedBody,
     keep: &[f64],
     o: &MannequinOptions,
 ) -> Result<SymmetricLayers, MannequinError> {
-    let m = &regions.landmarks;
+    let m = body.landmarks();
     let mut torso_z = spaced(m.crotch + CROTCH_CLEARANCE_MM, m.neck, o.torso_layers);
     let inner = 1..torso_z.len() - 1;
     for &z in keep {
@@ -62,7 +61,7 @@ pub(super) fn symmetric_layers(
     // Torso sections, with the arms cut off above the armpits.
     let torso_sections: Vec<(f64, Contour)> = torso_z
         .iter()
-        .zip(regions.torso_sections(body, &torso_z))
+        .zip(body.torso_sections(&torso_z))
         .map(|(&z, c)| {
             c.map(|c| (z, c)).ok_or(MannequinError::MissingLoop { region: Region::Torso, z })
         })
@@ -81,8 +80,8 @@ pub(super) fn symmetric_layers(
 
     let mut left_leg = Vec::with_capacity(o.leg_layers);
     let mut right_leg = Vec::with_capacity(o.leg_layers);
-    for s in sections(body, &leg_z) {
-        let labels = regions.label(&s);
+    for s in body.sections(&leg_z) {
+        let labels = body.regions().label(&s);
         let find = |region| {
             largest_with(&s, &labels, region)
                 .ok_or(MannequinError::MissingLoop { region, z: s.height })

@@ -19,7 +19,8 @@ mod shoulder_cap;
 mod thighs;
 
 use crate::mesh::Mesh;
-use crate::regions::{Armhole, BodyRegions, Landmarks, Region, RegionError};
+use crate::regions::{Armhole, Landmarks, Region, RegionError};
+use crate::segmented_body::SegmentedBody;
 use crate::symmetry::{Preserve, SymmetryError};
 use glam::{DVec2, DVec3};
 use rebuild::TorsoRing;
@@ -155,12 +156,10 @@ pub enum MannequinError {
     },
 }
 
-/// Builds the symmetric mannequin of `body` (canonical frame) segmented as `regions`, with a
-/// torso layer exactly at each of the `keep` heights (the chest, waist and hip levels, so that
+/// Builds the symmetric mannequin of the segmented `body` (canonical frame), with a torso layer exactly at each of the `keep` heights (the chest, waist and hip levels, so that
 /// the mannequin keeps exactly the girths a tailor measures).
 pub fn build(
-    body: &Mesh,
-    regions: &BodyRegions,
+    body: &SegmentedBody,
     keep: &[f64],
     options: &MannequinOptions,
 ) -> Result<Mannequin, MannequinError> {
@@ -172,10 +171,11 @@ pub fn build(
     }
     crate::symmetry::check_rays(options.rays)?;
     let layers::SymmetricLayers { axis, torso, mut left_leg, mut right_leg } =
-        layers::symmetric_layers(body, regions, keep, options)?;
-    let cap = shoulder_cap::build(body, &regions.landmarks, &torso, axis, options)?;
+        layers::symmetric_layers(body, keep, options)?;
+    let landmarks = *body.landmarks();
+    let cap = shoulder_cap::build(body.mesh(), &landmarks, &torso, axis, options)?;
     thighs::ease(&torso[0], &torso[1], &mut left_leg, &mut right_leg);
-    let own = symmetric_landmarks(&regions.landmarks, axis);
+    let own = symmetric_landmarks(&landmarks, axis);
     let plates = [&own.left_armhole, &own.right_armhole];
     let rings: Vec<TorsoRing> = torso
         .iter()
@@ -183,17 +183,11 @@ pub fn build(
         .map(|layer| arm_plates::rim(layer, axis, plates, options.preserve))
         .chain(cap.rings.iter().map(|ring| TorsoRing::from_rays(ring)))
         .collect();
-    let mesh = rebuild::rebuild(
-        &rings,
-        cap.neck_centre,
-        &left_leg,
-        &right_leg,
-        axis,
-        regions.landmarks.crotch,
-    );
+    let mesh =
+        rebuild::rebuild(&rings, cap.neck_centre, &left_leg, &right_leg, axis, landmarks.crotch);
     Ok(Mannequin {
         axis,
-        landmarks: regions.landmarks,
+        landmarks,
         options: *options,
         torso,
         left_leg,

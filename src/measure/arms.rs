@@ -14,7 +14,8 @@
 
 use super::plane::PlaneLoop;
 use crate::mesh::Mesh;
-use crate::regions::{BodyRegions, Region};
+use crate::regions::Region;
+use crate::segmented_body::SegmentedBody;
 use crate::slice::Contour;
 use glam::{DVec2, DVec3};
 use serde::Serialize;
@@ -65,27 +66,21 @@ pub struct ArmMeasures {
 
 /// The arm measurements of both sides (`None` for a side whose arm has no horizontal loops
 /// below its armpit long enough to hold an upper arm, forearm and hand).
-pub fn arms(body: &Mesh, regions: &BodyRegions) -> [Option<ArmMeasures>; 2] {
-    let m = &regions.landmarks;
+pub fn arms(body: &SegmentedBody) -> [Option<ArmMeasures>; 2] {
+    let m = body.landmarks();
     [(Region::LeftArm, &m.left_armhole), (Region::RightArm, &m.right_armhole)].map(
         |(region, armhole)| {
-            let loops = arm_loops(body, regions, region, armhole.armpit.z);
-            measure_arm(body, &loops, armhole.shoulder_point, m.height)
+            let loops = arm_loops(body, region, armhole.armpit.z);
+            measure_arm(body.mesh(), &loops, armhole.shoulder_point, m.height)
         },
     )
 }
 
 /// The arm's loops from just below its armpit down to its end, with their heights.
-fn arm_loops(
-    body: &Mesh,
-    regions: &BodyRegions,
-    region: Region,
-    armpit: f64,
-) -> Vec<(f64, Contour)> {
+fn arm_loops(body: &SegmentedBody, region: Region, armpit: f64) -> Vec<(f64, Contour)> {
     let zs: Vec<f64> =
         (1..).map(|k| armpit - STEP_MM * k as f64).take_while(|&z| z > 0.0).collect();
-    regions
-        .sections_of(body, region, &zs)
+    body.sections_of(region, &zs)
         .into_iter()
         .zip(&zs)
         .map_while(|(c, &z)| c.map(|c| (z, c)))

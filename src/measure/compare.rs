@@ -3,8 +3,7 @@
 
 use super::{Girth, Levels, Measurements, central_loops, measure_at};
 use crate::mannequin::Mannequin;
-use crate::mesh::Mesh;
-use crate::regions::BodyRegions;
+use crate::segmented_body::SegmentedBody;
 use crate::slice::{Contour, convex_hull};
 use glam::DVec2;
 use serde::Serialize;
@@ -75,16 +74,10 @@ fn width(c: &Contour) -> f64 {
     c.bounds().map_or(0.0, |b| b.size().x)
 }
 
-/// Compares `body` (with its `regions`) and its `mannequin` at the body's measurement
-/// `levels`.
-pub fn compare(
-    body: &Mesh,
-    regions: &BodyRegions,
-    levels: &Levels,
-    mannequin: &Mannequin,
-) -> Comparison {
+/// Compares `body` and its `mannequin` at the body's measurement `levels`.
+pub fn compare(body: &SegmentedBody, levels: &Levels, mannequin: &Mannequin) -> Comparison {
     let levels = *levels;
-    let input = measure_at(body, regions, &levels);
+    let input = measure_at(body, &levels);
     let zs = [levels.chest, levels.waist, levels.hip];
     let central = central_loops(&mannequin.mesh, mannequin.axis, &zs);
     let ours: Vec<Girth> = central
@@ -105,7 +98,7 @@ pub fn compare(
         })
         .collect();
 
-    let loops = regions.torso_sections(body, &zs);
+    let loops = body.torso_sections(&zs);
     let empty = Contour::default();
     let at = |k: usize| loops[k].as_ref().unwrap_or(&empty);
     let side = |body: &'static str, left: bool| {

@@ -1,13 +1,12 @@
-//! A tailor's measurement set, named as in ISO 8559-1, taken on a segmented body (its mesh,
-//! [`BodyRegions`] and measurement [`Levels`]): values in, values out, no stage re-deriving
-//! the regions. Each rule is stated on its field and in the README, so that a tailor can
+//! A tailor's measurement set, named as in ISO 8559-1, taken on a [`SegmentedBody`] at its
+//! measurement [`Levels`]: values in, values out, no stage re-deriving the regions. Each rule is stated on its field and in the README, so that a tailor can
 //! check it with a tape; lengths in millimetres, angles in degrees, heights above the floor.
 
 use super::arms::{ArmMeasures, arms};
 use super::neck_and_shoulders::{midline_profile, neck_and_shoulders};
 use super::{Girth, Levels, deepest_fold, forward, heights_between as heights};
-use crate::mesh::Mesh;
-use crate::regions::{BodyRegions, Region};
+use crate::regions::Region;
+use crate::segmented_body::SegmentedBody;
 use crate::slice::Contour;
 use glam::{DVec2, DVec3};
 use serde::Serialize;
@@ -124,8 +123,8 @@ fn tape(c: &Option<Contour>) -> f64 {
 }
 
 /// The length of the torso's midline profile from `from` up to `to` (front or back).
-fn midline_length(body: &Mesh, regions: &BodyRegions, from: f64, to: f64, front: bool) -> f64 {
-    let profile = midline_profile(body, regions, from, to, front);
+fn midline_length(body: &SegmentedBody, from: f64, to: f64, front: bool) -> f64 {
+    let profile = midline_profile(body, from, to, front);
     profile.windows(2).map(|w| w[0].distance(w[1])).sum()
 }
 
@@ -136,9 +135,9 @@ fn bilateral(arms: &[Option<ArmMeasures>; 2], pick: impl Fn(&ArmMeasures) -> f64
 }
 
 /// The tape girth of the left and right leg at each of `zs`: per height (left, right).
-fn leg_girths(body: &Mesh, regions: &BodyRegions, zs: &[f64]) -> Vec<(f64, f64)> {
-    let left = regions.sections_of(body, Region::LeftLeg, zs);
-    let right = regions.sections_of(body, Region::RightLeg, zs);
+fn leg_girths(body: &SegmentedBody, zs: &[f64]) -> Vec<(f64, f64)> {
+    let left = body.sections_of(Region::LeftLeg, zs);
+    let right = body.sections_of(Region::RightLeg, zs);
     left.iter().zip(&right).map(|(l, r)| (tape(l), tape(r))).collect()
 }
 
@@ -148,11 +147,11 @@ fn leg_girths(body: &Mesh, regions: &BodyRegions, zs: &[f64]) -> Vec<(f64, f64)>
 /// farthest back would be the chest level itself where that lies above the bust, at the
 /// armpits (the MakeHuman base body: underbust = chest). A front without a fold keeps the
 /// level set farthest back. `None` if the torso has no loops there.
-pub fn underbust(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> Option<Girth> {
-    let h = regions.landmarks.height;
+pub fn underbust(body: &SegmentedBody, levels: &Levels) -> Option<Girth> {
+    let h = body.landmarks().height;
     let under = heights(levels.chest - UNDERBUST_SPAN * h, levels.chest);
     let profile: Vec<(f64, Contour)> = (under.iter().copied())
-        .zip(regions.torso_sections(body, &under))
+        .zip(body.torso_sections(&under))
         .filter_map(|(z, c)| Some((z, c?)))
         .collect();
     let fronts: Vec<f64> = profile.iter().map(|(_, c)| forward(c)).collect();
@@ -161,13 +160,13 @@ pub fn underbust(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> Option<
     Some(Girth::of(profile[k].0, &profile[k].1))
 }
 
-/// The body dimensions of `body`, segmented as `regions`, with its measurement `levels`.
-pub fn dimensions(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> BodyDimensions {
-    let m = &regions.landmarks;
+/// The body dimensions of `body` with its measurement `levels`.
+pub fn dimensions(body: &SegmentedBody, levels: &Levels) -> BodyDimensions {
+    let m = body.landmarks();
     let h = m.height;
-    let torso = |zs: &[f64]| regions.torso_sections(body, zs);
+    let torso = |zs: &[f64]| body.torso_sections(zs);
 
-    let underbust = underbust(body, regions, levels).map_or(0.0, |g| g.tape);
+    let underbust = underbust(body, levels).map_or(0.0, |g| g.tape);
 
     let main =
         torso(&[levels.chest, levels.waist, 0.5 * (levels.waist + levels.hip), levels.hip, m.neck]);
@@ -190,12 +189,12 @@ pub fn dimensions(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> BodyDi
 
     // Legs: thigh, knee, ankle at their levels; the calf the largest between knee and ankle.
     let knee_z = KNEE_OF_CROTCH * m.crotch;
-    let fixed = leg_girths(body, regions, &[m.crotch - THIGH_BELOW_CROTCH * h, knee_z, m.ankle]);
-    let calf = leg_girths(body, regions, &heights(m.ankle, knee_z));
+    let fixed = leg_girths(body, &[m.crotch - THIGH_BELOW_CROTCH * h, knee_z, m.ankle]);
+    let calf = leg_girths(body, &heights(m.ankle, knee_z));
     let largest = |pick: fn(&(f64, f64)) -> f64| calf.iter().map(pick).fold(0.0, f64::max);
     let pair = |(l, r): (f64, f64)| Bilateral::new(l, r);
-    let arms = arms(body, regions);
-    let upper = neck_and_shoulders(body, regions);
+    let arms = arms(body);
+    let upper = neck_and_shoulders(body);
     let upper_value =
         |pick: fn(&super::NeckAndShoulders) -> f64| upper.as_ref().map_or(f64::NAN, pick);
 
@@ -223,7 +222,7 @@ pub fn dimensions(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> BodyDi
         wrist_girth_mm: bilateral(&arms, |a| a.wrist.girth),
         arm_length_mm: bilateral(&arms, |a| a.length),
         inside_leg_mm: m.crotch,
-        back_waist_length_mm: midline_length(body, regions, levels.waist, m.neck, false),
-        front_waist_length_mm: midline_length(body, regions, levels.waist, m.neck, true),
+        back_waist_length_mm: midline_length(body, levels.waist, m.neck, false),
+        front_waist_length_mm: midline_length(body, levels.waist, m.neck, true),
     }
 }

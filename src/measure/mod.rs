@@ -43,7 +43,7 @@ pub use neck_and_shoulders::{
 pub use plane::{PlaneLoop, tape_arc};
 
 use crate::mesh::Mesh;
-use crate::regions::BodyRegions;
+use crate::segmented_body::SegmentedBody;
 use crate::slice::{Contour, sections};
 use serde::Serialize;
 
@@ -147,21 +147,22 @@ pub struct FoundLevels {
     pub fallbacks: Vec<String>,
 }
 
-/// Finds the chest, waist and hip levels (see the module documentation for the rules).
-pub fn levels(body: &Mesh, regions: &BodyRegions) -> Levels {
-    find_levels(body, regions).levels
+/// Finds the chest, waist and hip levels of `body` (see the module documentation for the
+/// rules).
+pub fn levels(body: &SegmentedBody) -> Levels {
+    find_levels(body).levels
 }
 
 /// [`levels`], with a note for each level that fell back to a proportion of the body.
-pub fn find_levels(body: &Mesh, regions: &BodyRegions) -> FoundLevels {
+pub fn find_levels(body: &SegmentedBody) -> FoundLevels {
     let mut fallbacks = Vec::new();
-    let m = &regions.landmarks;
+    let m = body.landmarks();
     // Below the lower armpit a raised arm cannot join the torso's loop.
     let armpit = m.left_armpit.min(m.right_armpit);
     let (lo, hi) = (m.crotch + LEVEL_STEP_MM, armpit - LEVEL_STEP_MM);
     let count = (((hi - lo) / LEVEL_STEP_MM) as usize).max(2);
     let zs: Vec<f64> = (0..count).map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64).collect();
-    let loops = regions.torso_sections(body, &zs);
+    let loops = body.torso_sections(&zs);
     let samples: Vec<(f64, &Contour)> =
         zs.iter().zip(&loops).filter_map(|(&z, l)| l.as_ref().map(|l| (z, l))).collect();
     let best = |range: (f64, f64), score: &dyn Fn(&Contour) -> f64| {
@@ -285,18 +286,18 @@ pub fn warnings(body: &Mesh, levels: &Levels) -> Vec<String> {
         .collect()
 }
 
-/// Measures `body` at `levels`; `torso` picks the torso loop of a section.
-pub fn measure_at(body: &Mesh, regions: &BodyRegions, levels: &Levels) -> Measurements {
+/// Measures `body` at `levels`, on its torso's loops.
+pub fn measure_at(body: &SegmentedBody, levels: &Levels) -> Measurements {
     let zs = [levels.chest, levels.waist, levels.hip];
-    let loops = regions.torso_sections(body, &zs);
+    let loops = body.torso_sections(&zs);
     let girth = |k: usize| {
         loops[k]
             .as_ref()
             .map_or(Girth { z: zs[k], tape: 0.0, contour: 0.0 }, |c| Girth::of(zs[k], c))
     };
     Measurements {
-        height: regions.landmarks.height,
-        crotch_height: regions.landmarks.crotch,
+        height: body.landmarks().height,
+        crotch_height: body.landmarks().crotch,
         chest: girth(0),
         waist: girth(1),
         hip: girth(2),

@@ -24,8 +24,8 @@
 
 use super::heights_between as heights;
 use super::plane::{PlaneLoop, tape_arc};
-use crate::mesh::Mesh;
-use crate::regions::{Armhole, BodyRegions};
+use crate::regions::Armhole;
+use crate::segmented_body::SegmentedBody;
 use crate::slice::Contour;
 use glam::{DVec2, DVec3};
 use serde::Serialize;
@@ -88,18 +88,12 @@ fn corner(profile: &[DVec2], inside: DVec2) -> Option<DVec2> {
 
 /// The torso's midline profile from `from` to `to`: at each level the front-most (`front`) or
 /// back-most point within [`MIDLINE_BAND_MM`] of the centre line, as (y, z).
-pub(super) fn midline_profile(
-    body: &Mesh,
-    regions: &BodyRegions,
-    from: f64,
-    to: f64,
-    front: bool,
-) -> Vec<DVec2> {
+pub(super) fn midline_profile(body: &SegmentedBody, from: f64, to: f64, front: bool) -> Vec<DVec2> {
     let zs = heights(from, to);
-    let cx = regions.landmarks.centre_x;
+    let cx = body.landmarks().centre_x;
     let sign = if front { -1.0 } else { 1.0 };
     zs.iter()
-        .zip(regions.torso_sections(body, &zs))
+        .zip(body.torso_sections(&zs))
         .filter_map(|(&z, c)| {
             let y = c?
                 .points
@@ -115,18 +109,13 @@ pub(super) fn midline_profile(
 /// The side neck point on `side` (+1 the subject's left, -1 the right): the corner of the
 /// front silhouette (the torso's outermost x at each level) between the `shoulder_point` and
 /// the `neck` level.
-fn side_neck_point(
-    body: &Mesh,
-    regions: &BodyRegions,
-    shoulder_point: DVec3,
-    side: f64,
-) -> Option<DVec3> {
-    let m = &regions.landmarks;
+fn side_neck_point(body: &SegmentedBody, shoulder_point: DVec3, side: f64) -> Option<DVec3> {
+    let m = body.landmarks();
     let zs = heights(shoulder_point.z, m.neck);
     // (outward distance from the centre line, z) and the y of that outermost point.
     let silhouette: Vec<(DVec2, f64)> = zs
         .iter()
-        .zip(regions.torso_sections(body, &zs))
+        .zip(body.torso_sections(&zs))
         .filter_map(|(&z, c)| {
             let p = c?.points.into_iter().max_by(|a, b| (side * a.x).total_cmp(&(side * b.x)))?;
             Some((DVec2::new(side * (p.x - m.centre_x), z), p.y))
@@ -168,21 +157,21 @@ pub fn across_back_and_front(torso: &Contour, z: f64, armholes: [&Armhole; 2]) -
     (across(left.1, right.1, 1.0), across(left.0, right.0, -1.0))
 }
 
-/// The neck's and shoulders' measurements of `body`, segmented as `regions`; `None` where a
-/// landmark cannot be found (no torso loops between the armpits and the neck).
-pub fn neck_and_shoulders(body: &Mesh, regions: &BodyRegions) -> Option<NeckAndShoulders> {
-    let m = &regions.landmarks;
-    let front = midline_profile(body, regions, m.armpit(), m.neck, true);
+/// The neck's and shoulders' measurements of `body`; `None` where a landmark cannot be found
+/// (no torso loops between the armpits and the neck).
+pub fn neck_and_shoulders(body: &SegmentedBody) -> Option<NeckAndShoulders> {
+    let m = body.landmarks();
+    let mesh = body.mesh();
+    let front = midline_profile(body, m.armpit(), m.neck, true);
     let f = corner(&front, DVec2::X)?;
     let front_neck_point = DVec3::new(m.centre_x, f.x, f.y);
     let (lsp, rsp) = (m.left_armhole.shoulder_point, m.right_armhole.shoulder_point);
-    let side_neck_points =
-        [side_neck_point(body, regions, lsp, 1.0)?, side_neck_point(body, regions, rsp, -1.0)?];
+    let side_neck_points = [side_neck_point(body, lsp, 1.0)?, side_neck_point(body, rsp, -1.0)?];
 
     let [sl, sr] = side_neck_points;
     let normal = normal_through(front_neck_point, sl, sr);
     let origin = 0.5 * (sl + sr);
-    let neck = PlaneLoop::around(body, origin, normal)?;
+    let neck = PlaneLoop::around(mesh, origin, normal)?;
     let back_neck_point = (neck.contour.points.iter().map(|&p| neck.to_body(p)))
         .filter(|p| (p.x - m.centre_x).abs() <= MIDLINE_BAND_MM)
         .max_by(|a, b| a.y.total_cmp(&b.y))?;
@@ -190,7 +179,7 @@ pub fn neck_and_shoulders(body: &Mesh, regions: &BodyRegions) -> Option<NeckAndS
 
     let normal = normal_through(lsp, rsp, back_neck_point);
     let origin = 0.5 * (lsp + rsp);
-    let over = PlaneLoop::around(body, origin, normal)?;
+    let over = PlaneLoop::around(mesh, origin, normal)?;
     let length = tape_arc(
         &over.contour,
         over.to_plane(lsp),
@@ -200,7 +189,7 @@ pub fn neck_and_shoulders(body: &Mesh, regions: &BodyRegions) -> Option<NeckAndS
     let across_shoulder = PlaneMeasure { origin, normal, length };
 
     let across_level = 0.5 * (m.armpit() + lsp.z.min(rsp.z));
-    let torso = regions.torso_sections(body, &[across_level]).pop().flatten()?;
+    let torso = body.torso_sections(&[across_level]).pop().flatten()?;
     let (across_back, across_front) =
         across_back_and_front(&torso, across_level, [&m.left_armhole, &m.right_armhole]);
     Some(NeckAndShoulders {

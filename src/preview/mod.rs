@@ -17,6 +17,7 @@ pub use sections::sections_svg;
 
 use crate::mesh::Mesh;
 use crate::pipeline::Symmetrized;
+use crate::segmented_body::SegmentedBody;
 use crate::slice::Contour;
 use glam::DVec3;
 use raster::{Canvas, Colour};
@@ -176,8 +177,11 @@ fn preview_rgb(bodies: &[(&Mesh, &str)], result: &Symmetrized) -> (usize, usize,
     let m = &result.mannequin;
     let levels = &result.comparison.levels;
     let heights = [levels.chest, levels.waist, levels.hip];
-    let body_levels: Vec<Vec<Option<Contour>>> =
-        bodies.iter().map(|(mesh, _)| result.regions.torso_sections(mesh, &heights)).collect();
+    let body_levels: Vec<Vec<Option<Contour>>> = (bodies.iter())
+        .map(|(mesh, _)| {
+            SegmentedBody::with_regions(mesh, &result.regions).torso_sections(&heights)
+        })
+        .collect();
     let ring_at = |z: f64| {
         m.torso
             .iter()

@@ -5,6 +5,7 @@
 
 use crate::mesh::Mesh;
 use crate::pipeline::Symmetrized;
+use crate::segmented_body::SegmentedBody;
 use crate::slice::Contour;
 use glam::DVec2;
 use std::fmt::Write;
@@ -73,7 +74,7 @@ pub fn sections_svg(scan: &Mesh, result: &Symmetrized) -> String {
     let m = &result.mannequin;
     let c = &result.comparison;
     let heights = [c.levels.chest, c.levels.waist, c.levels.hip];
-    let sections = result.regions.torso_sections(scan, &heights);
+    let sections = SegmentedBody::with_regions(scan, &result.regions).torso_sections(&heights);
     let empty = Contour::default();
     let rings: Vec<Contour> = heights
         .iter()

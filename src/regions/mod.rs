@@ -195,44 +195,22 @@ impl BodyRegions {
         (tracking::track(body, step, floor, height, cut), requested)
     }
 
-    /// The torso's section at each of `heights` (`None` where there is none): the largest
-    /// loop labelled torso (at and above the neck, head), clipped to the inner side of both
-    /// armholes (above each armpit), so that it holds no arm material (an armless body has
-    /// none, and is not clipped).
-    pub fn torso_sections(&self, body: &Mesh, heights: &[f64]) -> Vec<Option<Contour>> {
+    /// The torso's loop in `section` (cut from the same body; `None` where there is none): the
+    /// largest loop labelled torso (at and above the neck, head), clipped to the inner side of
+    /// both armholes (above each armpit), so that it holds no arm material (an armless body
+    /// has none, and is not clipped).
+    pub fn torso_of(&self, section: &Section) -> Option<Contour> {
         let m = &self.landmarks;
-        sections(body, heights)
-            .into_iter()
-            .map(|s| {
-                let labels = self.label(&s);
-                let found = largest_with(&s, &labels, Region::Torso)
-                    .or_else(|| largest_with(&s, &labels, Region::Head));
-                found.map(|c| match self.labelling {
-                    Labelling::Tracked { .. } => {
-                        let c = m.left_armhole.clip(c, s.height);
-                        m.right_armhole.clip(&c, s.height)
-                    }
-                    Labelling::Armless => c.clone(),
-                })
-            })
-            .collect()
-    }
-
-    /// The section of `region` at each of `heights`: the torso's as [`Self::torso_sections`],
-    /// another region's as its largest loop.
-    pub fn sections_of(
-        &self,
-        body: &Mesh,
-        region: Region,
-        heights: &[f64],
-    ) -> Vec<Option<Contour>> {
-        if region == Region::Torso {
-            return self.torso_sections(body, heights);
-        }
-        sections(body, heights)
-            .into_iter()
-            .map(|s| largest_with(&s, &self.label(&s), region).cloned())
-            .collect()
+        let labels = self.label(section);
+        let found = largest_with(section, &labels, Region::Torso)
+            .or_else(|| largest_with(section, &labels, Region::Head));
+        found.map(|c| match self.labelling {
+            Labelling::Tracked { .. } => {
+                let c = m.left_armhole.clip(c, section.height);
+                m.right_armhole.clip(&c, section.height)
+            }
+            Labelling::Armless => c.clone(),
+        })
     }
 
     /// Labels for the loops of `section` (cut from the same body at any height): each loop
