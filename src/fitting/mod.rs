@@ -90,25 +90,67 @@ pub fn regions_of(form: &FormDescription) -> Vec<Region> {
 /// stroke; mirror pairs get equal extensions.
 ///
 /// ```
-/// use dressform::{fitting, mannequin::MannequinOptions, mesh::Mesh, pipeline, scan};
-/// use std::path::Path;
+/// use dressform::fitting;
+/// use dressform::measure::Levels;
+/// use dressform::profiles::{FORMAT, ProfileLayer, Profiles};
+/// use dressform::regions::{Armhole, Landmarks, Region};
+/// use dressform::symmetry::Preserve;
+/// use glam::DVec3;
+/// use std::f64::consts::TAU;
 ///
-/// // A synthetic customer (1700 mm, chest 960, waist 800, hip 1000 mm) taken as a scan, and
-/// // the profiles of its symmetric mannequin.
-/// let surface = sim::capture::generate(&Default::default()).unwrap().surface;
-/// let body = Mesh::new(surface.positions.iter().map(|&p| p.into()).collect(), surface.triangles);
-/// let scan = scan::from_mesh(body, Path::new("customer"), &Default::default()).unwrap();
-/// let mannequin = pipeline::symmetrize(&scan, &MannequinOptions::default(), |_| {}).unwrap();
+/// // The profiles of a round mannequin: a torso from the crotch (790 mm) to the neck (1480 mm)
+/// // whose girth runs hip 1000 (at 880 mm), waist 800 (1060), chest 960 (1250), and legs
+/// // 90 mm either side of the axis, 480 mm around at the top. Rings start at the front (-Y)
+/// // and run counter-clockwise seen from above.
+/// let girth = |knots: &[(f64, f64)], z: f64| {
+///     let k = knots.windows(2).position(|w| z <= w[1].0).unwrap_or(knots.len() - 2);
+///     let ((z0, g0), (z1, g1)) = (knots[k], knots[k + 1]);
+///     g0 + (g1 - g0) * (z - z0) / (z1 - z0)
+/// };
+/// let layer = |region, z: f64, x: f64, around: f64, n: usize| {
+///     let r = around / TAU;
+///     let at = |k: usize| TAU * k as f64 / n as f64 - TAU / 4.0;
+///     let points = (0..n).map(|k| [x + r * at(k).cos(), r * at(k).sin()]).collect();
+///     ProfileLayer {
+///         region, z, centre: [x, 0.0], points,
+///         input_tape_girth: around, input_contour_length: around,
+///         tape_girth: around, contour_length: around,
+///     }
+/// };
+/// let torso = [(790.0, 950.0), (880.0, 1000.0), (1060.0, 800.0), (1250.0, 960.0),
+///              (1400.0, 900.0), (1480.0, 380.0)];
+/// let legs = [(100.0, 220.0), (790.0, 480.0)];
+/// let heights = |from: f64, to: f64| (0..=69).map(move |k| from + (to - from) * k as f64 / 69.0);
+/// let mut layers = Vec::new();
+/// for (region, x) in [(Region::LeftLeg, 90.0), (Region::RightLeg, -90.0)] {
+///     layers.extend(heights(100.0, 789.0).map(|z| layer(region, z, x, girth(&legs, z), 72)));
+/// }
+/// layers.extend(heights(791.0, 1480.0).map(|z| layer(Region::Torso, z, 0.0, girth(&torso, z), 70)));
+/// let armhole = |side: f64| {
+///     let armpit = DVec3::new(side * 150.0, 0.0, 1300.0);
+///     Armhole::through(armpit, armpit + DVec3::new(side * 30.0, 0.0, 110.0), DVec3::NEG_Y, side)
+/// };
+/// let landmarks = Landmarks {
+///     height: 1700.0, crotch: 790.0, ankle: 100.0, left_armpit: 1300.0, right_armpit: 1300.0,
+///     neck: 1480.0, centre_x: 0.0, left_armhole: armhole(1.0), right_armhole: armhole(-1.0),
+/// };
+/// let profiles = Profiles {
+///     format: FORMAT.into(), frame: "canonical".into(), axis_x: 0.0, rays: 72,
+///     preserve: Preserve::Tape, levels: Levels { chest: 1250.0, waist: 1060.0, hip: 880.0 },
+///     landmarks, layers,
+/// };
 ///
 /// let form = form_description::reference();
-/// let fit = fitting::fit(&mannequin.profiles, &form).unwrap();
+/// let fit = fitting::fit(&profiles, &form).unwrap();
 /// for actuator in &form.actuators {
 ///     let extension = fit.positions_mm[&actuator.id];
 ///     assert!((0.0..=actuator.stroke_mm).contains(&extension)); // never beyond the stroke
 /// }
-/// // The waist ring takes the mannequin's girth there (within the 1 mm a mannequin's surface
-/// // is known to, and the panels' polygon).
+/// // The waist ring sits at the waist level and takes the mannequin's girth there (800.8 mm:
+/// // the 800 mm circle's, between two layers), within the panels' polygon.
 /// let waist = fit.rings.iter().find(|r| r.ring == "waist").unwrap();
+/// assert_eq!(waist.mannequin_height_mm, 1060.0);
+/// assert!((waist.mannequin_girth_mm - 800.0).abs() < 2.0);
 /// assert!((waist.form_girth_mm - waist.mannequin_girth_mm).abs() < 2.0);
 /// ```
 pub fn fit(profiles: &Profiles, form: &FormDescription) -> Result<Fit, FitError> {
