@@ -9,6 +9,7 @@
 
 use super::Failure;
 use super::link::{self, FormArg, LinkArgs, runtime};
+use dressform::controller::open::OpenLink;
 use dressform::controller::simulated::SimConfig;
 use dressform::controller::{Connection, LinkSpec, control, emergency_stop, fault_names};
 use std::time::Duration;
@@ -46,12 +47,17 @@ pub fn run(args: &EstopArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// A simulated form started for this command: stopped, then every node shown.
+/// A simulated form started for this command (opened as every command opens `--sim`):
+/// stopped, then every node shown.
 fn on_sim(args: &EstopArgs) -> Result<(), Failure> {
     let form = args.form.load()?;
     let truth = runtime()?.block_on(async {
-        let rig = link::simulated(&form, &SimConfig::default())?;
-        emergency_stop(&rig.attach()).map_err(Failure::other)?;
+        let OpenLink { connection, rig } =
+            link::open(&LinkSpec::Sim, &form, &SimConfig::default())?;
+        let rig = rig.ok_or_else(|| Failure::other("the simulated form did not start"))?;
+        emergency_stop(&connection).map_err(Failure::other)?;
+        // The host's side closes before the simulated form stops (as `OpenLink` drops them).
+        drop(connection);
         let deadline = tokio::time::Instant::now() + SETTLE;
         let latched = || rig.truth().nodes.iter().all(|n| !n.faults.is_empty());
         while !latched() && tokio::time::Instant::now() < deadline {

@@ -91,10 +91,7 @@ pub struct Owned {
 /// signals with its gate. Must be called within a tokio runtime.
 pub fn own(spec: &LinkSpec, form: &FormDescription, sim: &SimConfig) -> Result<Owned, Failure> {
     let endpoint = Endpoint::bind(spec).map_err(Failure::other)?;
-    let OpenLink { connection, rig } = OpenLink::open(spec, form, sim).map_err(|e| match e {
-        OpenError::Hardware(e) => Failure::other(e),
-        OpenError::Sim(e) => sim_failure(e),
-    })?;
+    let OpenLink { connection, rig } = open(spec, form, sim)?;
     if let Some(endpoint) = &endpoint {
         endpoint.arm(connection.gate()).map_err(Failure::other)?;
     }
@@ -102,10 +99,13 @@ pub fn own(spec: &LinkSpec, form: &FormDescription, sim: &SimConfig) -> Result<O
     Ok(Owned { connection, rig, _armed: armed, _endpoint: endpoint })
 }
 
-/// Starts the in-process simulated form (for a command that watches it rather than drives
-/// it: `estop --sim`).
-pub fn simulated(form: &FormDescription, config: &SimConfig) -> Result<SimulatedRig, Failure> {
-    SimulatedRig::start(form, config).map_err(sim_failure)
+/// Opens the link `spec` names ([`OpenLink::open`]: with `--sim`, starts the simulated `form`
+/// as `sim` says), without owning it. Must be called within a tokio runtime.
+pub fn open(spec: &LinkSpec, form: &FormDescription, sim: &SimConfig) -> Result<OpenLink, Failure> {
+    OpenLink::open(spec, form, sim).map_err(|e| match e {
+        OpenError::Hardware(e) => Failure::other(e),
+        OpenError::Sim(e) => sim_failure(e),
+    })
 }
 
 /// How a simulated form's failure ends the command: its description or faults are bad

@@ -5,7 +5,7 @@
 
 use super::Failure;
 use super::link::FormArg;
-use dressform::fitting::{Fit, SHAPE_NOTE_MM, fit, regions_of};
+use dressform::fitting::{Fit, fit, regions_of};
 use dressform::profiles::Profiles;
 use std::path::PathBuf;
 
@@ -49,50 +49,22 @@ pub fn fidelity_table(fit: &Fit) -> String {
         "ring", "form z", "body z", "mannequin", "form", "gap"
     );
     for r in &fit.rings {
-        let excess = r.mannequin_girth_mm - r.form_girth_mm;
-        let status = if r.mannequin_girth_mm == 0.0 {
-            "no body".to_string()
-        } else if excess.abs() >= SHAPE_NOTE_MM {
-            format!("girth {excess:+.0} mm out of reach")
-        } else if r.saturated.is_empty() {
-            "ok".to_string()
-        } else {
-            "shape limited".to_string()
-        };
         let _ = writeln!(
             s,
-            "  {:<12} {:>8.0} {:>8.0} {:>11.1} {:>9.1} {:>9.1}  {status}",
+            "  {:<12} {:>8.0} {:>8.0} {:>11.1} {:>9.1} {:>9.1}  {}",
             r.ring,
             r.form_height_mm,
             r.mannequin_height_mm,
             r.mannequin_girth_mm,
             r.form_girth_mm,
             r.largest_radial_gap_mm,
+            r.status(),
         );
     }
     let _ = writeln!(s, "  (girths and the largest radial gap between panel and mannequin, mm)");
     for r in fit.saturated() {
-        let excess = r.mannequin_girth_mm - r.form_girth_mm;
-        let size = if excess >= SHAPE_NOTE_MM {
-            format!("{excess:.0} mm of girth beyond the form's largest size")
-        } else if excess <= -SHAPE_NOTE_MM {
-            format!("{:.0} mm of girth below the form's smallest size", -excess)
-        } else {
-            "girth matched; shape limited".to_string()
-        };
-        let actuators: Vec<String> = r
-            .saturated
-            .iter()
-            .map(|a| {
-                let side = if a.beyond_mm > 0.0 {
-                    "beyond its stroke"
-                } else {
-                    "inside its retracted end"
-                };
-                format!("{} {:.1} mm {side}", a.actuator, a.beyond_mm.abs())
-            })
-            .collect();
-        let _ = writeln!(s, "  {}: {size} ({})", r.ring, actuators.join(", "));
+        let actuators: Vec<String> = r.saturated.iter().map(|a| a.to_string()).collect();
+        let _ = writeln!(s, "  {}: {} ({})", r.ring, r.girth_reach(), actuators.join(", "));
     }
     s
 }

@@ -1,6 +1,6 @@
 //! Fitting the robotic form to a mannequin: where each of the form's rings meets the mannequin
 //! ([`placement`]), and the actuator extensions that make each ring take the mannequin's
-//! section ([`rings`]), with a fidelity report.
+//! section ([`rings`]), with a fidelity report ([`RingStatus`], [`GirthReach`]).
 //!
 //! **Placement rule.** A ring whose description states an `anchor` (`neck`, `chest`, `waist`,
 //! `hip`) is set to the mannequin's neck landmark or its chest, waist or hip level; a ring
@@ -13,10 +13,12 @@
 //! **Frame.** The mannequin's symmetry plane is put on the form's (x = 0); both use the
 //! canonical frame otherwise (+X = the subject's left, front = -Y).
 
+mod fidelity;
 pub mod outcome;
 mod placement;
 mod rings;
 
+pub use fidelity::{GirthReach, RingStatus};
 pub use outcome::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
 pub use placement::Placement;
 pub use rings::{RingFit, SHAPE_NOTE_MM, Saturation, region_of, ring_girth};
