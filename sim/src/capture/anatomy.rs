@@ -178,8 +178,25 @@ const REF_KNOTS: [RefKnot; 11] = [
     knot(0.0, 0.0, 0.0, 2.0, 2.0, [0.0, 0.0, 1.0]),      // neck base
 ];
 
+/// The knots of [`REF_KNOTS`] by name: their indices, bottom to top.
+const CROTCH_KNOT: usize = 0;
+const GLUTEAL_FOLD_KNOT: usize = 1;
+const HIP_KNOT: usize = 2;
+const ABDOMEN_KNOT: usize = 3;
+const WAIST_KNOT: usize = 4;
+const UNDERBUST_KNOT: usize = 5;
+const CHEST_KNOT: usize = 6;
+const ARMPIT_KNOT: usize = 7;
+const SHOULDER_JOINT_KNOT: usize = 8;
+const ACROMION_KNOT: usize = 9;
+const NECK_BASE_KNOT: usize = 10;
+
 /// Index of the hip, waist and chest knots in [`REF_KNOTS`].
-const LEVEL_KNOTS: [usize; 3] = [2, 4, 6];
+const LEVEL_KNOTS: [usize; 3] = [HIP_KNOT, WAIST_KNOT, CHEST_KNOT];
+
+// Numbers below without a cited source are the generator's own design, chosen so that its
+// customers' sections look like scanned bodies' (tests/synthetic_bodies.rs in the root crate
+// checks the bodies they make).
 
 /// Fractions of the stature: the shoulder-joint knot (where the torso's horizontal scale is
 /// back to 1), the acromion knot, the neck-base knot, and the torso's top plane.
@@ -187,6 +204,73 @@ const Z_SHOULDER_KNOT: f64 = 0.80;
 const Z_ACROMION: f64 = 0.82;
 const Z_NECK_KNOT: f64 = 0.842;
 const Z_TORSO_TOP: f64 = 0.85;
+/// The armpit knot, a fraction of the stature: between the nipple line (0.720) and the
+/// shoulder joint (0.80).
+const Z_ARMPIT_KNOT: f64 = 0.765;
+/// The waist level, a fraction of the stature: the natural waist lies at the elbow's level with
+/// the arms hanging (0.630 H, Drillis and Contini); the generator's customers have it a
+/// centimetre and a half lower.
+const WAIST_OF_STATURE: f64 = 0.62;
+/// The chest level, a fraction of the stature: the nipple line (0.720 H, Drillis and Contini).
+const CHEST_OF_STATURE: f64 = 0.72;
+/// The hip level, a fraction of the way from the crotch up to the waist: low on the pelvis,
+/// where the buttocks protrude most.
+const HIP_FROM_CROTCH: f64 = 0.3;
+/// How far below the crotch the torso's lowest knot lies, a fraction of the stature: the
+/// torso reaches down between the thighs' tops.
+const CROTCH_KNOT_BELOW: f64 = 0.01;
+/// The gluteal fold knot, a fraction of the way from the crotch up to the hip level.
+const GLUTEAL_FOLD_FROM_CROTCH: f64 = 0.35;
+/// The under-bust knot, a fraction of the way from the waist up to the chest.
+const UNDERBUST_FROM_WAIST: f64 = 0.6;
+
+/// A belly starts to round where the waist is this fraction of the hip girth, and is fully
+/// round [`BELLY_SPAN`] further.
+const BELLY_FROM_RATIO: f64 = 0.8;
+const BELLY_SPAN: f64 = 0.25;
+/// A full belly brings the abdomen's and waist's fronts this fraction forward, and narrows
+/// them by [`BELLY_NARROWING`].
+const BELLY_FORWARD: f64 = 0.4;
+const BELLY_NARROWING: f64 = 0.06;
+/// Hips as large as the chest are neutral; the hip-to-chest ratio this far off either way
+/// widens (or narrows) the knots up to the hip by [`HIP_WIDENING`].
+const HIPNESS_SPAN: f64 = 0.25;
+const HIP_WIDENING: f64 = 0.06;
+
+/// How far inside half the shoulder width the shoulder-joint and acromion knots end, as
+/// fractions of the stature (the deltoids fill out the rest).
+const SHOULDER_JOINT_INSET: f64 = 0.005;
+const ACROMION_INSET: f64 = 0.012;
+/// The neck-base knot in neck radii: half-width, and how far its front and back lie from the
+/// neck's axis (the neck is deeper behind: the trapezius).
+const NECK_BASE_HALF_WIDTH: f64 = 1.25;
+const NECK_BASE_FRONT: f64 = 1.05;
+const NECK_BASE_BACK: f64 = 1.2;
+
+/// How far the breasts stand out of the chest wall on a body of [`REF_CHEST_MM`] (mm): this
+/// much at bust prominence 0, plus [`BUST_PER_PROMINENCE_MM`] times the prominence; in
+/// proportion to the chest girth on others.
+const BUST_BASE_MM: f64 = 6.0;
+const BUST_PER_PROMINENCE_MM: f64 = 50.0;
+/// The reference body's chest girth (mm): [`BodyParams::default`]'s.
+const REF_CHEST_MM: f64 = 960.0;
+/// The breast ellipsoid in the chest knot's half-widths: its centre's distance from the
+/// midline and its semi-axes across and (at least) deep; its height is [`BREAST_RZ_OF_RX`] of
+/// its width, and it is at least [`BREAST_MIN_DEPTH_MM`] deeper than it protrudes.
+const BREAST_X: f64 = 0.5;
+const BREAST_RX: f64 = 0.42;
+const BREAST_RY: f64 = 0.3;
+const BREAST_RZ_OF_RX: f64 = 0.9;
+const BREAST_MIN_DEPTH_MM: f64 = 10.0;
+/// The buttock ellipsoid: its centre's distance from the midline and its width in the hip
+/// knot's half-widths, its depth in the hip knot's depths, how far behind the hip knot's back
+/// it reaches (in depths), and how far above the hip level it reaches (a fraction of the
+/// stature).
+const BUTTOCK_X: f64 = 0.5;
+const BUTTOCK_RX: f64 = 0.45;
+const BUTTOCK_RY: f64 = 0.3;
+const BUTTOCK_BEHIND: f64 = 0.06;
+const BUTTOCK_ABOVE_HIP: f64 = 0.02;
 
 impl Anatomy {
     /// Designs the body for `p` (which must pass the range checks of
@@ -195,124 +279,162 @@ impl Anatomy {
         let h = p.height_mm;
         let crotch = p.leg_length_mm;
         let girths = [p.hip_girth_mm, p.waist_girth_mm, p.chest_girth_mm];
+        let levels = level_heights(p);
+        let [z_hip, z_waist, z_chest] = levels;
+        let knot_z = knot_heights(p, levels);
 
-        // Heights of the levels and knots.
-        let z_waist = 0.62 * h;
-        let z_chest = 0.72 * h;
-        let z_hip = crotch + 0.3 * (z_waist - crotch);
-        let knot_z = [
-            crotch - 0.01 * h,
-            crotch + 0.35 * (z_hip - crotch),
-            z_hip,
-            0.5 * (z_hip + z_waist),
-            z_waist,
-            z_waist + 0.6 * (z_chest - z_waist),
-            z_chest,
-            0.765 * h,
-            Z_SHOULDER_KNOT * h,
-            Z_ACROMION * h,
-            Z_NECK_KNOT * h,
-        ];
-
-        // Shape adjustments: a round belly when the waist nears the hips, wider hips when
-        // they exceed the chest.
-        let belly = ((p.waist_girth_mm / p.hip_girth_mm - 0.8) / 0.25).clamp(0.0, 1.0);
-        let hipness = ((p.hip_girth_mm / p.chest_girth_mm - 1.0) / 0.25).clamp(-1.0, 1.0);
-        let shaped: Vec<Section> = REF_KNOTS
-            .iter()
-            .zip(knot_z)
-            .enumerate()
-            .map(|(i, (r, z))| {
-                let mut s = Section {
-                    z,
-                    half_width: r.half_width,
-                    y_front: r.y_front,
-                    y_back: r.y_back,
-                    n_front: r.n_front,
-                    n_back: r.n_back,
-                };
-                if i == 3 || i == 4 {
-                    s.y_front *= 1.0 + 0.4 * belly;
-                    s.half_width *= 1.0 - 0.06 * belly;
-                }
-                if i <= 2 {
-                    s.half_width *= 1.0 + 0.06 * hipness;
-                }
-                s
-            })
-            .collect();
-
-        // Size each level to its girth; the other knots follow their levels.
-        let lambda: [f64; 3] =
-            std::array::from_fn(|l| girths[l] / shaped[LEVEL_KNOTS[l]].perimeter());
-        let mut knots: Vec<Section> = shaped
-            .iter()
-            .zip(REF_KNOTS.iter())
-            .map(|(s, r)| s.scaled((0..3).map(|l| r.follows[l] * lambda[l]).sum()))
-            .collect();
-        // Centre y = 0 at the waist.
-        let y0 = knots[4].centre_y();
-        for s in &mut knots {
-            s.y_front -= y0;
-            s.y_back -= y0;
-        }
-        let chest = knots[6];
+        let mut knots = sized_knots(&shaped_knots(p, knot_z), girths);
+        let chest = knots[CHEST_KNOT];
         let head = design_head(p, &chest);
-
-        // The shoulders: as wide as the shoulder width at the joints, sloping up to the neck.
-        let half_s = 0.5 * p.shoulder_width_mm;
-        knots[8].half_width = half_s - 0.005 * h;
-        knots[9].half_width = half_s - 0.012 * h;
-        let (nb, rn) = (head.neck_base, head.r_neck);
-        knots[10] = Section {
-            half_width: 1.25 * rn,
-            y_front: nb.y - 1.05 * rn,
-            y_back: nb.y + 1.2 * rn,
-            ..knots[10]
-        };
-
-        let bust_protrusion = (6.0 + 50.0 * p.bust_prominence) * p.chest_girth_mm / 960.0;
-        let breast = {
-            let rx = 0.42 * chest.half_width;
-            let ry = (0.3 * chest.half_width).max(bust_protrusion + 10.0);
-            let x = 0.5 * chest.half_width;
-            let y = chest.front_y_at(x) + ry - bust_protrusion;
-            (DVec3::new(x, y, z_chest), DVec3::new(rx, ry, 0.9 * rx))
-        };
-        let buttock = {
-            let hip = knots[2];
-            let depth = hip.y_back - hip.y_front;
-            let (rx, ry, rz) = (0.45 * hip.half_width, 0.3 * depth, (z_hip - crotch) + 0.02 * h);
-            let y = hip.y_back + 0.06 * depth - ry;
-            (DVec3::new(0.5 * hip.half_width, y, z_hip), DVec3::new(rx, ry, rz))
-        };
-
+        shape_shoulders(&mut knots, p, &head);
+        let (breast, bust_protrusion) = design_breast(p, &chest, z_chest);
+        let buttock = design_buttock(p, &knots[HIP_KNOT], z_hip);
         let arms = [0, 1].map(|side| design_arm(p, side, &chest, &head));
-        let legs = [0, 1].map(|side| design_leg(p, side, &knots[2]));
+        let legs = [0, 1].map(|side| design_leg(p, side, &knots[HIP_KNOT]));
 
         Anatomy {
             height: h,
             crotch_height: crotch,
             girths,
-            levels: [z_hip, z_waist, z_chest],
+            levels,
             knots,
             torso_top: Z_TORSO_TOP * h,
-            armpit_knot: knot_z[7],
+            armpit_knot: knot_z[ARMPIT_KNOT],
             scale_free_above: Z_SHOULDER_KNOT * h,
             breast,
             buttock,
             bust_protrusion,
             arms,
             legs,
-            warp: SpineWarp {
-                band: (z_waist, Z_SHOULDER_KNOT * h),
-                bend: p.pose.spine.lateral_bend_deg.to_radians(),
-                twist: p.pose.spine.twist_deg.to_radians(),
-                neck_axis: (head.neck_base.x, head.neck_base.y),
-                head_turn: p.pose.head_turn_deg.to_radians(),
-            },
+            warp: spine_warp(p, z_waist, &head),
             head,
         }
+    }
+}
+
+/// The heights of the hip, waist and chest levels.
+fn level_heights(p: &BodyParams) -> [f64; 3] {
+    let (h, crotch) = (p.height_mm, p.leg_length_mm);
+    let z_waist = WAIST_OF_STATURE * h;
+    let z_chest = CHEST_OF_STATURE * h;
+    let z_hip = crotch + HIP_FROM_CROTCH * (z_waist - crotch);
+    [z_hip, z_waist, z_chest]
+}
+
+/// The heights of the torso knots, bottom to top, from the `levels` (hip, waist, chest).
+fn knot_heights(p: &BodyParams, [z_hip, z_waist, z_chest]: [f64; 3]) -> [f64; 11] {
+    let (h, crotch) = (p.height_mm, p.leg_length_mm);
+    let mut z = [0.0; 11];
+    z[CROTCH_KNOT] = crotch - CROTCH_KNOT_BELOW * h;
+    z[GLUTEAL_FOLD_KNOT] = crotch + GLUTEAL_FOLD_FROM_CROTCH * (z_hip - crotch);
+    z[HIP_KNOT] = z_hip;
+    z[ABDOMEN_KNOT] = 0.5 * (z_hip + z_waist);
+    z[WAIST_KNOT] = z_waist;
+    z[UNDERBUST_KNOT] = z_waist + UNDERBUST_FROM_WAIST * (z_chest - z_waist);
+    z[CHEST_KNOT] = z_chest;
+    z[ARMPIT_KNOT] = Z_ARMPIT_KNOT * h;
+    z[SHOULDER_JOINT_KNOT] = Z_SHOULDER_KNOT * h;
+    z[ACROMION_KNOT] = Z_ACROMION * h;
+    z[NECK_BASE_KNOT] = Z_NECK_KNOT * h;
+    z
+}
+
+/// The reference knots at `knot_z`, shaped for `p`: a round belly when the waist nears the
+/// hips, wider hips when they exceed the chest.
+fn shaped_knots(p: &BodyParams, knot_z: [f64; 11]) -> Vec<Section> {
+    let belly =
+        ((p.waist_girth_mm / p.hip_girth_mm - BELLY_FROM_RATIO) / BELLY_SPAN).clamp(0.0, 1.0);
+    let hipness = ((p.hip_girth_mm / p.chest_girth_mm - 1.0) / HIPNESS_SPAN).clamp(-1.0, 1.0);
+    REF_KNOTS
+        .iter()
+        .zip(knot_z)
+        .enumerate()
+        .map(|(i, (r, z))| {
+            let mut s = Section {
+                z,
+                half_width: r.half_width,
+                y_front: r.y_front,
+                y_back: r.y_back,
+                n_front: r.n_front,
+                n_back: r.n_back,
+            };
+            if i == ABDOMEN_KNOT || i == WAIST_KNOT {
+                s.y_front *= 1.0 + BELLY_FORWARD * belly;
+                s.half_width *= 1.0 - BELLY_NARROWING * belly;
+            }
+            if i <= HIP_KNOT {
+                s.half_width *= 1.0 + HIP_WIDENING * hipness;
+            }
+            s
+        })
+        .collect()
+}
+
+/// The `shaped` knots sized so that each level's knot has its girth (hip, waist, chest) and
+/// the others follow their levels, centred so that y = 0 at the waist.
+fn sized_knots(shaped: &[Section], girths: [f64; 3]) -> Vec<Section> {
+    let lambda: [f64; 3] = std::array::from_fn(|l| girths[l] / shaped[LEVEL_KNOTS[l]].perimeter());
+    let mut knots: Vec<Section> = shaped
+        .iter()
+        .zip(REF_KNOTS.iter())
+        .map(|(s, r)| s.scaled((0..3).map(|l| r.follows[l] * lambda[l]).sum()))
+        .collect();
+    let y0 = knots[WAIST_KNOT].centre_y();
+    for s in &mut knots {
+        s.y_front -= y0;
+        s.y_back -= y0;
+    }
+    knots
+}
+
+/// The shoulders: as wide as the shoulder width at the joints, sloping up to the neck, whose
+/// base knot is sized from the `head`'s neck.
+fn shape_shoulders(knots: &mut [Section], p: &BodyParams, head: &Head) {
+    let h = p.height_mm;
+    let half_s = 0.5 * p.shoulder_width_mm;
+    knots[SHOULDER_JOINT_KNOT].half_width = half_s - SHOULDER_JOINT_INSET * h;
+    knots[ACROMION_KNOT].half_width = half_s - ACROMION_INSET * h;
+    let (nb, rn) = (head.neck_base, head.r_neck);
+    knots[NECK_BASE_KNOT] = Section {
+        half_width: NECK_BASE_HALF_WIDTH * rn,
+        y_front: nb.y - NECK_BASE_FRONT * rn,
+        y_back: nb.y + NECK_BASE_BACK * rn,
+        ..knots[NECK_BASE_KNOT]
+    };
+}
+
+/// The left breast's ellipsoid (centre, semi-axes) on the `chest` knot at `z_chest`, and how far
+/// it stands out of the chest wall.
+fn design_breast(p: &BodyParams, chest: &Section, z_chest: f64) -> ((DVec3, DVec3), f64) {
+    let bust_protrusion = (BUST_BASE_MM + BUST_PER_PROMINENCE_MM * p.bust_prominence)
+        * p.chest_girth_mm
+        / REF_CHEST_MM;
+    let rx = BREAST_RX * chest.half_width;
+    let ry = (BREAST_RY * chest.half_width).max(bust_protrusion + BREAST_MIN_DEPTH_MM);
+    let x = BREAST_X * chest.half_width;
+    let y = chest.front_y_at(x) + ry - bust_protrusion;
+    ((DVec3::new(x, y, z_chest), DVec3::new(rx, ry, BREAST_RZ_OF_RX * rx)), bust_protrusion)
+}
+
+/// The left buttock's ellipsoid (centre, semi-axes) behind the `hip` knot at `z_hip`.
+fn design_buttock(p: &BodyParams, hip: &Section, z_hip: f64) -> (DVec3, DVec3) {
+    let (h, crotch) = (p.height_mm, p.leg_length_mm);
+    let depth = hip.y_back - hip.y_front;
+    let (rx, ry, rz) =
+        (BUTTOCK_RX * hip.half_width, BUTTOCK_RY * depth, (z_hip - crotch) + BUTTOCK_ABOVE_HIP * h);
+    let y = hip.y_back + BUTTOCK_BEHIND * depth - ry;
+    (DVec3::new(BUTTOCK_X * hip.half_width, y, z_hip), DVec3::new(rx, ry, rz))
+}
+
+/// The spine's bend and twist between the waist (`z_waist`) and the shoulder joints, and the
+/// head's turn about the neck's axis, as `p`'s pose has them.
+fn spine_warp(p: &BodyParams, z_waist: f64, head: &Head) -> SpineWarp {
+    SpineWarp {
+        band: (z_waist, Z_SHOULDER_KNOT * p.height_mm),
+        bend: p.pose.spine.lateral_bend_deg.to_radians(),
+        twist: p.pose.spine.twist_deg.to_radians(),
+        neck_axis: (head.neck_base.x, head.neck_base.y),
+        head_turn: p.pose.head_turn_deg.to_radians(),
     }
 }
 
