@@ -176,28 +176,6 @@ fn crotch_creases(mesh: &Mesh, axis: f64, crotch: f64) -> (f64, f64) {
 /// line across the thighs.
 const JOIN_LINE_DEG: f64 = 3.0;
 
-/// The checks with known misses.
-const SHOULDER_LINE: &str = "shoulder line";
-const JOIN_LINE: &str = "join line";
-
-/// Bodies on which a check is known to fail, with the reason; printed on every run.
-const KNOWN_MISSES: &[(&str, &str, &str)] = &[
-    (
-        "random-10",
-        SHOULDER_LINE,
-        "5.1 mm at 190 mm out: with no ring bent below the shoulder points, the band from the \
-         highest plate layer to the first bent ring cuts under the rounded acromion",
-    ),
-    ("random-2", JOIN_LINE, "15.3 degrees against 1.0: not the thigh's pull; cause not found"),
-    ("random-4", JOIN_LINE, "11.4 degrees against 0.8: as random-2"),
-    ("random-8", JOIN_LINE, "4.0 degrees against 0.9: as random-2"),
-    ("random-17", JOIN_LINE, "7.0 degrees against 0.9: as random-2"),
-];
-
-fn known_miss(name: &str, check: &str) -> bool {
-    KNOWN_MISSES.iter().any(|(n, c, _)| *n == name && *c == check)
-}
-
 /// A ring lies this close to the crotch height on either side of the join (mm): the legs'
 /// top ring and the lowest torso ring are 1 mm from it.
 const JOIN_RINGS_MM: f64 = 1.5;
@@ -436,9 +414,6 @@ fn check_all(cases: Vec<Case>) {
             r.rim.map_or("-".into(), |(t, n)| format!("{t:.0}/{n}"))
         );
     }
-    for (name, check, why) in KNOWN_MISSES {
-        eprintln!("known miss: {name}: {check}: {why}");
-    }
     for r in &reports {
         let name = &r.name;
         assert_eq!(r.self_intersections, 0, "{name}: self-intersecting triangle pairs");
@@ -448,7 +423,7 @@ fn check_all(cases: Vec<Case>) {
             "{name}: the width jumps above the shoulder points more than the body's: {:?}",
             r.shoulder_jump
         );
-        if let Some(gap) = r.shoulder_line.filter(|_| !known_miss(name, SHOULDER_LINE)) {
+        if let Some(gap) = r.shoulder_line {
             assert!(gap <= SHOULDER_LINE_MM, "{name}: shoulder line {gap:.1} mm from the body's");
         }
         assert!(r.crotch_ledge.1 <= LEDGE_FACE_MM2, "{name}: a ledge at the crotch: {r:?}");
@@ -458,7 +433,7 @@ fn check_all(cases: Vec<Case>) {
         );
         assert!(r.seam_crease.0 <= SEAM_CREASE_DEG, "{name}: the crotch join creases: {r:?}");
         assert!(
-            known_miss(name, JOIN_LINE) || r.join_line.0 <= r.join_line.1 + JOIN_LINE_DEG,
+            r.join_line.0 <= r.join_line.1 + JOIN_LINE_DEG,
             "{name}: a line along the crotch join: {:?}",
             r.join_line
         );

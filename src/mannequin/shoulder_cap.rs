@@ -44,6 +44,15 @@ const WING_SLOPE: f64 = 1.0;
 /// layers at the paper's 100 torso layers, so no band between two rings is steep sideways.
 const RAMP_MM: f64 = 30.0;
 
+/// Mesh rings in the cap per torso layer: the band between two rings is a chord of the
+/// shoulder top, and on a rounded acromion (the generator's random-10) the chord between rings
+/// a layer (7.3 mm) apart sagged 5.1 mm under the body's silhouette; half as far apart, it
+/// sags a quarter as much.
+const RINGS_PER_LAYER: usize = 2;
+
+/// Heights closer than this are one (mm): a torso layer at the lower shoulder point itself.
+const SAME_HEIGHT_MM: f64 = 1e-6;
+
 /// The rings of the mesh from [`ShoulderCap::from`] up to the neck.
 pub(super) struct ShoulderCap {
     /// The lowest height at which the rings bend; the torso layers below it are the mesh's
@@ -110,6 +119,29 @@ fn bent_sections(body: &Mesh, bends: &[(Bend, DVec2)], lm: &Landmarks) -> Vec<Op
         .collect()
 }
 
+/// The heights `t` of the cap's rings, each with a point inside its section: `from`, every
+/// torso layer above it and [`RINGS_PER_LAYER`]` - 1` evenly between each two of those
+/// (their points inside interpolated).
+fn stations(torso: &[Layer], from: f64) -> Vec<(f64, DVec2)> {
+    let above = torso.iter().filter(|layer| layer.z >= from);
+    let mut ends: Vec<(f64, DVec2)> =
+        above.map(|layer| (layer.z, DVec2::from_array(layer.centre))).collect();
+    match ends.first() {
+        Some(&(z, centre)) if z - from > SAME_HEIGHT_MM => ends.insert(0, (from, centre)),
+        _ => {}
+    }
+    let mut out = Vec::with_capacity(ends.len() * RINGS_PER_LAYER);
+    for pair in ends.windows(2) {
+        let ((z0, c0), (z1, c1)) = (pair[0], pair[1]);
+        out.extend((0..RINGS_PER_LAYER).map(|k| {
+            let s = k as f64 / RINGS_PER_LAYER as f64;
+            (z0 + (z1 - z0) * s, c0.lerp(c1, s))
+        }));
+    }
+    out.extend(ends.last());
+    out
+}
+
 /// The shoulder cap of `body` (see the module documentation), whose horizontal torso layers
 /// (bottom to top, the last at the neck) are `torso`, about the plane x = `axis`.
 pub(super) fn build(
@@ -127,12 +159,11 @@ pub(super) fn build(
     // Every bent ring lies above the lower shoulder point: below it every horizontal slice of
     // the mesh is a torso layer, girth and all.
     let from = shoulder_z;
-    let bends: Vec<(Bend, DVec2)> = torso
-        .iter()
-        .filter(|layer| layer.z >= from)
-        .map(|layer| {
-            let slope = WING_SLOPE * smoothstep((layer.z - from) / RAMP_MM);
-            (Bend { t: layer.z, slope, axis, wing }, DVec2::from_array(layer.centre))
+    let bends: Vec<(Bend, DVec2)> = stations(torso, from)
+        .into_iter()
+        .map(|(t, inside)| {
+            let slope = WING_SLOPE * smoothstep((t - from) / RAMP_MM);
+            (Bend { t, slope, axis, wing }, inside)
         })
         .collect();
     let part = body.part(|tri| tri.iter().any(|&v| body.positions[v as usize].z >= from));
