@@ -10,6 +10,7 @@ use form_description::FormDescription;
 use crate::fitting::{self, Fit, FitError, region_of, regions_of};
 use crate::mannequin::{self, Mannequin, MannequinError, MannequinOptions};
 use crate::measure::{Comparison, compare, levels};
+use crate::mesh::Mesh;
 use crate::profiles::Profiles;
 use crate::regions::{BodyRegions, TRACKING_STEP_MM};
 use crate::scan::Scan;
@@ -126,36 +127,50 @@ pub fn shape(
     Ok(Shaped { symmetrized, fit, setpoints, rings })
 }
 
-/// The scan's and the mannequin's girths at every ring of `form` as `fit` placed them: the
-/// scan is cut once per region, at the heights of all the rings shaping it.
+/// The scan's and the mannequin's girths at every ring of `form` as `fit` placed them.
 fn ring_girths(
     scan: &Scan,
     symmetrized: &Symmetrized,
     form: &FormDescription,
     fit: &Fit,
 ) -> Vec<RingGirths> {
+    let heights: Vec<f64> = fit.rings.iter().map(|r| r.mannequin_height_mm).collect();
+    let scanned = girths_at_rings(&scan.body, &symmetrized.regions, form, &heights);
+    fit.rings
+        .iter()
+        .zip(scanned)
+        .map(|(r, scan_mm)| RingGirths {
+            ring: r.ring.clone(),
+            body_z_mm: r.mannequin_height_mm,
+            scan_mm,
+            mannequin_mm: r.mannequin_girth_mm,
+        })
+        .collect()
+}
+
+/// The tape girth of `body` (segmented as `regions`) for each ring of `form`, in the form's
+/// order, at the body height `heights` gives for it: the section of the ring's region there
+/// (`None` where the body has none). The body is cut once per region, at the heights of all
+/// the rings shaping it.
+pub fn girths_at_rings(
+    body: &Mesh,
+    regions: &BodyRegions,
+    form: &FormDescription,
+    heights: &[f64],
+) -> Vec<Option<f64>> {
     let mut scanned: BTreeMap<&str, Option<f64>> = BTreeMap::new();
     for region in regions_of(form) {
         let rings: Vec<(&str, f64)> = form
             .rings
             .iter()
-            .zip(&fit.rings)
+            .zip(heights)
             .filter(|(ring, _)| region_of(ring) == region)
-            .map(|(ring, r)| (ring.name.as_str(), r.mannequin_height_mm))
+            .map(|(ring, &z)| (ring.name.as_str(), z))
             .collect();
-        let heights: Vec<f64> = rings.iter().map(|r| r.1).collect();
-        let sections = symmetrized.regions.sections_of(&scan.body, region, &heights);
-        for (&(name, _), section) in rings.iter().zip(sections) {
+        let at: Vec<f64> = rings.iter().map(|r| r.1).collect();
+        for (&(name, _), section) in rings.iter().zip(regions.sections_of(body, region, &at)) {
             scanned.insert(name, section.map(|c| c.tape_girth()));
         }
     }
-    fit.rings
-        .iter()
-        .map(|r| RingGirths {
-            ring: r.ring.clone(),
-            body_z_mm: r.mannequin_height_mm,
-            scan_mm: scanned.get(r.ring.as_str()).copied().flatten(),
-            mannequin_mm: r.mannequin_girth_mm,
-        })
-        .collect()
+    form.rings.iter().map(|ring| scanned.get(ring.name.as_str()).copied().flatten()).collect()
 }
