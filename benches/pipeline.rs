@@ -1,8 +1,9 @@
 //! Benchmarks of the scan side on the realistic MakeHuman body, subdivided to scanner
 //! density: slicing alone, the full `symmetrize` (alone, and with the pictures it writes:
 //! `preview.png` and `sections.svg`), and the whole `dressform slice` process; then
-//! `reconstruct` (issue 15) of a posed MakeHuman body at 300k triangles: the fit alone, the
-//! library call, and the whole `dressform reconstruct` process with its seven outputs.
+//! `reconstruct` (issue 15) of the demo's asymmetrically standing customer at about 300k
+//! triangles: the fit alone, the library call, and the whole `dressform reconstruct` process
+//! with its outputs.
 //!
 //! `cargo bench --bench pipeline`; needs `../shared/makehuman` (or `$DRESSFORM_MAKEHUMAN`).
 
@@ -127,39 +128,35 @@ fn benches(c: &mut Criterion) {
     group.finish();
 }
 
-/// Issue 15's benchmark size: a scan of 300k triangles.
-const RECONSTRUCT_TRIANGLES: usize = 300_000;
-
+/// `reconstruct` (issue 15: a scan of about 300k triangles, the whole process <= 3 s, the fit
+/// <= 2 s) on the demo's customer: the sim generator's default body, meshed at its 4 mm grid
+/// (about 300k triangles), standing with the left arm 15 degrees and the right leg 5 degrees
+/// further out, captured with a typical scanner's noise and holes and written as binary PLY.
 fn reconstruct_benches(c: &mut Criterion) {
     use dressform::body_model::BodyModel;
     use dressform::fit::{self, FitOptions, ScanPoints};
-    use dressform::makehuman::{MakeHuman, Pose};
     use dressform::reconstruct::{ReconstructOptions, reconstruct};
-    let Some(dir) = makehuman() else {
-        eprintln!("SKIPPED: MakeHuman assets not found (set DRESSFORM_MAKEHUMAN)");
-        return;
-    };
-    // A customer with the left arm 15 degrees further out and the right leg 5 out.
-    let mh = MakeHuman::load(&dir).expect("the MakeHuman assets load");
-    let body = mh.shaped(&[]).expect("the mean body");
-    let pose = Pose::rest()
-        .rotate("upperarm01.L", DVec3::Y * -15f64.to_radians())
-        .rotate("upperleg01.R", DVec3::Y * 5f64.to_radians());
-    let skin = mh.base.skin(&mh.pose(&body, &pose).expect("posed"));
-    let k = (RECONSTRUCT_TRIANGLES as f64 / skin.triangles.len() as f64).sqrt().ceil() as u32;
-    let dense = subdivide(&skin, k);
-    let n = dense.triangles.len();
+    use sim::capture::{Artifacts, BodyParams, capture, generate};
+    let mut params = BodyParams::default();
+    params.pose.left_arm.abduction_deg += 15.0;
+    params.pose.right_leg.abduction_deg += 5.0;
+    let body = generate(&params).expect("the demo customer generates");
+    let raw = capture(&body, &Artifacts::typical_scanner(0));
+    let mesh =
+        Mesh::new(raw.positions.iter().map(|&p| DVec3::from_array(p)).collect(), raw.triangles);
+    let n = mesh.triangles.len();
     let tmp = tempfile::tempdir().expect("temporary directory");
     let ply = tmp.path().join("scan.ply");
-    std::fs::write(&ply, Format::Ply.encode(&dense)).expect("write the PLY");
+    std::fs::write(&ply, Format::Ply.encode(&mesh)).expect("write the PLY");
     let scan = scan::load(&ply, &FrameOptions::default()).expect("the scan loads");
     let model = BodyModel::builtin();
     let mut group = c.benchmark_group("reconstruct");
     group.sample_size(10);
+    let extended = fit::segment_lengths::extended(&model);
     group.bench_function(format!("fit alone, {n} triangles"), |b| {
         b.iter(|| {
             let points = ScanPoints::of_mesh(&scan.body);
-            fit::fit(&model, &points, &FitOptions::default()).expect("fit")
+            fit::fit(&extended, &points, &FitOptions::default()).expect("fit")
         })
     });
     group.bench_function(format!("reconstruct (library), {n} triangles"), |b| {

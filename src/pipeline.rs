@@ -138,30 +138,43 @@ pub fn shape(
 }
 
 /// The scan's (`body`'s) and the mannequin's girths at every ring of `form` as `fit` placed
-/// them: the scan is cut once per region, at the heights of all the rings shaping it.
+/// them.
 fn ring_girths(body: &SegmentedBody, form: &FormDescription, fit: &Fit) -> Vec<RingGirths> {
+    let heights: Vec<f64> = fit.rings.iter().map(|r| r.mannequin_height_mm).collect();
+    let scanned = girths_at_rings(body, form, &heights);
+    fit.rings
+        .iter()
+        .zip(scanned)
+        .map(|(r, scan_mm)| RingGirths {
+            ring: r.ring.clone(),
+            body_z_mm: r.mannequin_height_mm,
+            scan_mm,
+            mannequin_mm: r.mannequin_girth_mm,
+        })
+        .collect()
+}
+
+/// The tape girth of `body` for each ring of `form`, in the form's order, at the body height
+/// `heights` gives for it: the section of the ring's region there (`None` where the body has
+/// none). The body is cut once per region, at the heights of all the rings shaping it.
+pub fn girths_at_rings(
+    body: &SegmentedBody,
+    form: &FormDescription,
+    heights: &[f64],
+) -> Vec<Option<f64>> {
     let mut scanned: BTreeMap<&str, Option<f64>> = BTreeMap::new();
     for region in regions_of(form) {
         let rings: Vec<(&str, f64)> = form
             .rings
             .iter()
-            .zip(&fit.rings)
+            .zip(heights)
             .filter(|(ring, _)| region_of(ring) == region)
-            .map(|(ring, r)| (ring.name.as_str(), r.mannequin_height_mm))
+            .map(|(ring, &z)| (ring.name.as_str(), z))
             .collect();
-        let heights: Vec<f64> = rings.iter().map(|r| r.1).collect();
-        let sections = body.sections_of(region, &heights);
-        for (&(name, _), section) in rings.iter().zip(sections) {
+        let at: Vec<f64> = rings.iter().map(|r| r.1).collect();
+        for (&(name, _), section) in rings.iter().zip(body.sections_of(region, &at)) {
             scanned.insert(name, section.map(|c| c.tape_girth()));
         }
     }
-    fit.rings
-        .iter()
-        .map(|r| RingGirths {
-            ring: r.ring.clone(),
-            body_z_mm: r.mannequin_height_mm,
-            scan_mm: scanned.get(r.ring.as_str()).copied().flatten(),
-            mannequin_mm: r.mannequin_girth_mm,
-        })
-        .collect()
+    form.rings.iter().map(|ring| scanned.get(ring.name.as_str()).copied().flatten()).collect()
 }

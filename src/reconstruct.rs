@@ -1,18 +1,21 @@
 //! Scan to mannequin with pose symmetry first (the paper's whole of section 3): fit the body
-//! model to the scan (eq. 4), give the scan the model's rig, re-pose it symmetric (eq. 3), and
-//! build the mannequin of that ([`crate::pipeline::symmetrize`]). Used by `reconstruct`, `run`
-//! and `demo`.
+//! model to the scan (eq. 4), give the scan the model's rig, re-pose it symmetric (eq. 3)
+//! ([`repose`]), then the shape symmetry of that: the mannequin alone ([`reconstruct`], for
+//! `reconstruct`) or the mannequin with the form fitted to it ([`reconstruct_shape`], for `run`
+//! and `demo`).
 
 use crate::body_model::BodyModel;
 use crate::fit::verdict::{self, NotConverged, RegionResidual};
 use crate::fit::{self, Fit, FitError, FitOptions};
 use crate::mannequin::{MannequinError, MannequinOptions};
-use crate::measure::{Girth, Measurements, levels, measure_at};
-use crate::pipeline::{self, Symmetrized};
+use crate::measure::{Comparison, Girth, Measurements, levels, measure_at};
+use crate::pipeline::{self, ShapeError, Shaped, Symmetrized};
 use crate::pose_symmetry::{self, PoseOverrides};
+use crate::regions::BodyRegions;
 use crate::rig_transfer::{self, RigTransfer};
 use crate::scan::Scan;
 use crate::segmented_body::SegmentedBody;
+use form_description::FormDescription;
 use glam::DVec3;
 use serde::Serialize;
 
@@ -27,14 +30,14 @@ pub struct ReconstructOptions {
     pub mannequin: MannequinOptions,
 }
 
-/// The steps of [`reconstruct`], reported to `progress` as they start: these, then
-/// [`pipeline::STEPS`].
+/// The steps of [`repose`], reported to `progress` as they start; [`reconstruct`] goes on with
+/// [`pipeline::STEPS`], [`reconstruct_shape`] with [`pipeline::SHAPE_STEPS`].
 pub const STEPS: [&str; 3] =
     ["fitting the body model", "transferring the rig", "re-posing the scan symmetric"];
 
-/// What [`reconstruct`] made.
+/// A scan re-posed symmetric: what [`repose`] made.
 #[derive(Debug, Clone)]
-pub struct Reconstruction {
+pub struct Reposed {
     /// The model as fitted: the one given with its limb segments' lengths as more shape
     /// directions ([`fit::segment_lengths`]); `fit`'s beta is its.
     pub model: BodyModel,
@@ -48,12 +51,36 @@ pub struct Reconstruction {
     pub rig: RigTransfer,
     /// The pose-symmetric scan (same vertices and triangles as the input, moved).
     pub posed: Scan,
-    /// Its mannequin and measurements.
-    pub result: Symmetrized,
+    /// The input scan's segmentation, where it can be segmented as it stands.
+    pub scan_regions: Option<BodyRegions>,
     /// The input scan's own measurements, where it can be segmented as it stands.
     pub scan_measurements: Option<Measurements>,
     /// The fit's wall time (s).
     pub fit_seconds: f64,
+}
+
+/// What [`reconstruct`] made: the re-posed scan and its mannequin.
+#[derive(Debug, Clone)]
+pub struct Reconstruction {
+    /// The fit and the pose-symmetric scan.
+    pub reposed: Reposed,
+    /// The pose-symmetric scan's mannequin and measurements.
+    pub result: Symmetrized,
+}
+
+/// What [`reconstruct_shape`] made: the re-posed scan, its mannequin and the form fitted to
+/// it.
+#[derive(Debug, Clone)]
+pub struct Reshaped {
+    /// The fit and the pose-symmetric scan.
+    pub reposed: Reposed,
+    /// The mannequin of the pose-symmetric scan, the form's fit and set-points, and the
+    /// pose-symmetric scan's and the mannequin's girths at every ring.
+    pub shaped: Shaped,
+    /// The input scan's tape girth at every ring (form order; `None` where it has no section
+    /// there or cannot be segmented as it stands), at the height the ring shapes on the
+    /// pose-symmetric scan.
+    pub scan_rings: Vec<Option<f64>>,
 }
 
 /// Why a reconstruction failed.
@@ -68,16 +95,20 @@ pub enum ReconstructError {
     /// The pose-symmetric scan gave no mannequin.
     #[error("the pose-symmetric scan: {0}")]
     Mannequin(#[from] MannequinError),
+    /// The form could not be fitted to the mannequin.
+    #[error("the pose-symmetric scan: {0}")]
+    Shape(#[from] ShapeError),
 }
 
-/// Reconstructs the mannequin of `scan` (canonical frame) with `model`, calling
-/// `progress(step)` before each step (indices into [`STEPS`] then [`pipeline::STEPS`]).
-pub fn reconstruct(
+/// Fits `model` to `scan` (canonical frame), gives the scan the model's rig and re-poses it
+/// symmetric, calling `progress(step)` before each of [`STEPS`]. A fit that does not match
+/// the scan is an error ([`NotConverged`]), never a re-posed body.
+pub fn repose(
     scan: &Scan,
     model: &BodyModel,
     options: &ReconstructOptions,
     mut progress: impl FnMut(usize),
-) -> Result<Reconstruction, ReconstructError> {
+) -> Result<Reposed, ReconstructError> {
     progress(0);
     let extended = fit::segment_lengths::extended(model);
     let model = &extended;
@@ -114,20 +145,63 @@ pub fn reconstruct(
     posed.frame.translate(&mut posed.body, DVec3::Z * drop);
     posed.frame.centre_on_torso(&mut posed.body);
 
-    let result = pipeline::symmetrize(&posed, &options.mannequin, |s| progress(STEPS.len() + s))?;
-    let scan_measurements =
-        SegmentedBody::find(body).ok().map(|body| measure_at(&body, &levels(&body)));
-    Ok(Reconstruction {
+    let scan_body = SegmentedBody::find(body).ok();
+    let scan_measurements = scan_body.as_ref().map(|body| measure_at(body, &levels(body)));
+    let scan_regions = scan_body.map(SegmentedBody::into_regions);
+    Ok(Reposed {
         model: extended,
         fit: fitted,
         symmetric,
         residuals,
         rig,
         posed,
-        result,
+        scan_regions,
         scan_measurements,
         fit_seconds,
     })
+}
+
+/// Reconstructs the mannequin of `scan` (canonical frame) with `model`, calling
+/// `progress(step)` before each step (indices into [`STEPS`] then [`pipeline::STEPS`]).
+pub fn reconstruct(
+    scan: &Scan,
+    model: &BodyModel,
+    options: &ReconstructOptions,
+    mut progress: impl FnMut(usize),
+) -> Result<Reconstruction, ReconstructError> {
+    let reposed = repose(scan, model, options, &mut progress)?;
+    let result =
+        pipeline::symmetrize(&reposed.posed, &options.mannequin, |s| progress(STEPS.len() + s))?;
+    Ok(Reconstruction { reposed, result })
+}
+
+/// The whole chain of `run` and `demo`: [`repose`], then the mannequin of the pose-symmetric
+/// scan with `form` fitted to it ([`pipeline::shape`]), and the input scan's girths at the
+/// rings beside the pose-symmetric scan's; `progress(step)` before each step (indices into
+/// [`STEPS`] then [`pipeline::SHAPE_STEPS`]).
+pub fn reconstruct_shape(
+    scan: &Scan,
+    model: &BodyModel,
+    options: &ReconstructOptions,
+    form: &FormDescription,
+    mut progress: impl FnMut(usize),
+) -> Result<Reshaped, ReconstructError> {
+    let reposed = repose(scan, model, options, &mut progress)?;
+    let shaped =
+        pipeline::shape(&reposed.posed, &options.mannequin, form, |s| progress(STEPS.len() + s))?;
+    // The pose-symmetric scan's frame is the input's moved by the feet's drop (and centred):
+    // a ring's height on the input is its height there less that move.
+    let dz =
+        reposed.posed.frame.file_frame().translation[2] - scan.frame.file_frame().translation[2];
+    let heights: Vec<f64> = shaped.rings.iter().map(|r| r.body_z_mm - dz).collect();
+    let scan_rings = match &reposed.scan_regions {
+        Some(regions) => {
+            let body = SegmentedBody::with_regions(&scan.body, regions);
+            pipeline::girths_at_rings(&body, form, &heights)
+        }
+        None => vec![None; heights.len()],
+    };
+    Ok(Reshaped { reposed, shaped, scan_rings })
 }
 
 /// How far re-posing from `fitted.theta` to `symmetric` lowers the feet (mm; negative when it
@@ -151,7 +225,7 @@ pub struct MeasurementsReport<'a> {
     /// The input scan's measurements (`null` when it cannot be segmented as it stands).
     pub scan: Option<&'a Measurements>,
     /// Table 1 and Fig. 11 of the pose-symmetric scan and its mannequin.
-    pub pose_symmetric: &'a crate::measure::Comparison,
+    pub pose_symmetric: &'a Comparison,
 }
 
 /// One row of the three-column Table 1.
@@ -179,10 +253,8 @@ pub struct FitReport {
     pub translation_mm: [f64; 3],
     /// Root mean square distances of the last iteration's pairs.
     pub residuals: fit::Residuals,
-    /// Per body region, the distance of the model to the scan.
+    /// Per body region, the distance of the model to the scan, and the verdict's limit.
     pub regions: Vec<RegionResidual>,
-    /// The verdict's threshold on a region's median (mm).
-    pub max_region_median_mm: f64,
     /// LM iterations.
     pub iterations: usize,
     /// The fit's wall time (s).
@@ -202,10 +274,9 @@ pub struct JointAngles {
     pub symmetric_deg: [f64; 3],
 }
 
-impl Reconstruction {
-    /// `measurements.json`.
-    pub fn measurements(&self) -> MeasurementsReport<'_> {
-        let c = &self.result.comparison;
+impl Reposed {
+    /// `measurements.json` of the pose-symmetric scan's `comparison` with its mannequin.
+    pub fn measurements<'a>(&'a self, c: &'a Comparison) -> MeasurementsReport<'a> {
         let scan = self.scan_measurements.as_ref();
         let table = c
             .table
@@ -241,7 +312,6 @@ impl Reconstruction {
             translation_mm: self.fit.translation.to_array(),
             residuals: self.fit.residuals,
             regions: self.residuals.clone(),
-            max_region_median_mm: verdict::MAX_REGION_MEDIAN_MM,
             iterations: self.fit.iterations,
             seconds: self.fit_seconds,
             rig_filled_vertices: self.rig.filled,

@@ -96,11 +96,6 @@ pub fn transfer(
     }
     let coords: Vec<[f64; 3]> = model.positions.iter().map(|p| p.to_array()).collect();
     let tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&coords);
-    let dense = |v: usize| {
-        let mut w = vec![0.0; bones];
-        model_weights.of(v).for_each(|(b, x)| w[b] += x);
-        w
-    };
     // Per scan vertex: the interpolated weights, and whether they are trusted.
     let nearest: Vec<(Vec<f64>, bool)> = scan
         .positions
@@ -124,7 +119,7 @@ pub fn transfer(
             let mut w = vec![0.0; bones];
             let mut normal = DVec3::ZERO;
             for (&v, &b) in tri.iter().zip(&bary) {
-                dense(v as usize).iter().zip(&mut w).for_each(|(x, y)| *y += b * x);
+                model_weights.of(v as usize).for_each(|(bone, x)| w[bone] += b * x);
                 normal += b * model_normals[v as usize];
             }
             let trusted = d2.sqrt() <= TRUSTED_DISTANCE_MM
@@ -155,6 +150,7 @@ fn inpaint(scan: &Mesh, weights: &mut [Vec<f64>], trusted: &[bool]) -> usize {
     let mut round: Vec<usize> = trusted.iter().map(|&t| if t { 0 } else { usize::MAX }).collect();
     let mut front: Vec<usize> = (0..n).filter(|&v| trusted[v]).collect();
     let mut order = Vec::new();
+    let mut mean = vec![0.0; weights.first().map_or(0, Vec::len)];
     let mut r = 0;
     while !front.is_empty() {
         r += 1;
@@ -169,8 +165,8 @@ fn inpaint(scan: &Mesh, weights: &mut [Vec<f64>], trusted: &[bool]) -> usize {
             }
         }
         for &u in &next {
-            if let Some(m) = mean_of(&neighbours[u], weights, |x| round[x] < r) {
-                weights[u] = m;
+            if mean_of(&neighbours[u], weights, |x| round[x] < r, &mut mean) {
+                weights[u].copy_from_slice(&mean);
             }
         }
         order.extend_from_slice(&next);
@@ -178,28 +174,32 @@ fn inpaint(scan: &Mesh, weights: &mut [Vec<f64>], trusted: &[bool]) -> usize {
     }
     for _ in 0..FILL_SWEEPS {
         for &v in &order {
-            if let Some(m) = mean_of(&neighbours[v], weights, |_| true) {
-                weights[v] = m;
+            if mean_of(&neighbours[v], weights, |_| true, &mut mean) {
+                weights[v].copy_from_slice(&mean);
             }
         }
     }
     order.len()
 }
 
-/// The mean weights of the `neighbours` that `usable` accepts, if any.
+/// The mean weights of the `neighbours` that `usable` accepts, into `mean` (as long as a
+/// vertex's weights); whether there was any.
 fn mean_of(
     neighbours: &[u32],
     weights: &[Vec<f64>],
     usable: impl Fn(usize) -> bool,
-) -> Option<Vec<f64>> {
-    let mut sum: Option<Vec<f64>> = None;
+    mean: &mut [f64],
+) -> bool {
+    mean.fill(0.0);
     let mut count = 0.0;
     for &u in neighbours.iter().filter(|&&u| usable(u as usize)) {
-        let s = sum.get_or_insert_with(|| vec![0.0; weights[u as usize].len()]);
-        s.iter_mut().zip(&weights[u as usize]).for_each(|(a, b)| *a += b);
+        mean.iter_mut().zip(&weights[u as usize]).for_each(|(a, b)| *a += b);
         count += 1.0;
     }
-    sum.map(|s| s.into_iter().map(|x| x / count).collect())
+    if count > 0.0 {
+        mean.iter_mut().for_each(|a| *a /= count);
+    }
+    count > 0.0
 }
 
 /// Each vertex's strongest bones (at most `MAX_INFLUENCES`) as multiples of `WEIGHT_QUANTUM`

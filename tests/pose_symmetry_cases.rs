@@ -341,12 +341,12 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         // Angles: the truth in the body's own frame, the fit's in its root's (the yaw).
         let names = &model.skeleton.names;
         let bone = |name: &str| names.iter().position(|n| n == name).unwrap();
-        let fitted_joints = rec.fit.joints(&rec.model);
-        let root = DQuat::from_scaled_axis(rec.fit.theta[0]);
+        let fitted_joints = rec.reposed.fit.joints(&rec.reposed.model);
+        let root = DQuat::from_scaled_axis(rec.reposed.fit.theta[0]);
         let want = limb_angles(joint, DQuat::IDENTITY);
         let got = limb_angles(|n| fitted_joints[bone(n)], root);
         let sum = |bones: &[&str], axis: usize| -> f64 {
-            bones.iter().map(|b| rec.fit.theta[bone(b)][axis].to_degrees()).sum()
+            bones.iter().map(|b| rec.reposed.fit.theta[bone(b)][axis].to_degrees()).sum()
         };
         let spine = ["spine04", "spine03", "spine02", "spine01"];
         let (bend, twist) = (sum(&spine, 1), sum(&spine, 2));
@@ -363,7 +363,7 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         let at = levels(&SegmentedBody::find(&truth.body).unwrap());
         let heights = [at.chest, at.waist, at.hip];
         let girth_want = girths(&truth.body, &heights);
-        let girth_got = girths(&rec.posed.body, &heights);
+        let girth_got = girths(&rec.reposed.posed.body, &heights);
         let girth_err: Vec<f64> =
             girth_want.iter().zip(&girth_got).map(|(a, b)| (a - b).abs()).collect();
         let girth_mean = girth_err.iter().sum::<f64>() / 3.0;
@@ -374,10 +374,10 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
             case.shape.0.rsplit('/').next().unwrap(),
             case.shape.1,
             case.yaw_deg,
-            rec.fit_seconds,
-            rec.fit.iterations,
-            rec.fit.residuals.model_to_scan_mm,
-            rec.fit.residuals.scan_to_model_mm,
+            rec.reposed.fit_seconds,
+            rec.reposed.fit.iterations,
+            rec.reposed.fit.residuals.model_to_scan_mm,
+            rec.reposed.fit.residuals.scan_to_model_mm,
         );
         for (k, name) in LIMB_NAMES.iter().enumerate() {
             row += &format!(" {name} {:.1}/{:.1}", want[k], got[k]);
@@ -505,11 +505,14 @@ fn reconstruct_straightens_the_sim_generators_asymmetric_bodies() {
         let rec = reconstruct(&scan, &model, &ReconstructOptions::default(), |_| {})
             .unwrap_or_else(|e| panic!("sim body, {what}: {e}"));
         let heights = [at.chest.min(rec.result.comparison.levels.chest), at.waist, at.hip];
-        let (want, got) = (girths(&reference.body, &heights), girths(&rec.posed.body, &heights));
+        let (want, got) =
+            (girths(&reference.body, &heights), girths(&rec.reposed.posed.body, &heights));
         let err: Vec<f64> = want.iter().zip(&got).map(|(a, b)| (a - b).abs()).collect();
         eprintln!(
             "sim body, {what}: fit {:.1} s, rms {:.2}/{:.2} mm; chest, waist, hip {want:.0?} pose-symmetric {got:.0?} off {err:.1?} mm",
-            rec.fit_seconds, rec.fit.residuals.model_to_scan_mm, rec.fit.residuals.scan_to_model_mm
+            rec.reposed.fit_seconds,
+            rec.reposed.fit.residuals.model_to_scan_mm,
+            rec.reposed.fit.residuals.scan_to_model_mm
         );
         if err.iter().any(|&e| exceeds(e, GIRTH_TOLERANCE_MM)) {
             misses.push(format!("{what}: chest, waist and hip off by {err:.1?} mm"));

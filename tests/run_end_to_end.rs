@@ -54,7 +54,14 @@ fn run_over(transport: Transport, flag: &str) {
             "{flag} {id}: the simulated panel is at {real:.3} mm, set-point {mm:.3}"
         );
     }
-    for name in ["mannequin.obj", "profiles.json", "measurements.json"] {
+    for name in [
+        "mannequin.obj",
+        "posed.obj",
+        "rigged.glb",
+        "fit.json",
+        "profiles.json",
+        "measurements.json",
+    ] {
         assert!(out.join(name).is_file(), "{name}");
     }
 }

@@ -1,21 +1,25 @@
 //! `dressform demo [--out DIR] [--seed N]`: the whole system on a built-in synthetic customer —
-//! generate a body with known measurements (`sim`), scan it with a typical scanner's artifacts
-//! (noise, holes, metres, Y up, turned), encode the scan as PLY and read it back, build the symmetric
-//! mannequin, fit the reference form and drive the simulated form over the in-process bus —
-//! then compare the customer's true girths with the scan's and the mannequin's.
+//! generate a body with known measurements (`sim`) standing asymmetrically (one arm further out,
+//! one leg out), scan it with a typical scanner's artifacts (noise, holes, metres, Y up,
+//! turned), encode the scan as PLY and read it back, re-pose it symmetric (the body model
+//! fitted to it), build the symmetric mannequin, fit the reference form and drive the simulated
+//! form over the in-process bus — then compare the customer's true girths with the scan's, the
+//! pose-symmetric scan's and the mannequin's.
 
 use super::drive::{SimArgs, shape_verdict};
-use super::run::{Drive, shape_form};
+use super::run::{Drive, Reconstruct, shape_form};
 use super::{Failure, progress_bar};
+use dressform::body_model::BodyModel;
 use dressform::controller::{DriveOptions, LinkSpec};
 use dressform::fitting::DEFAULT_GIRTH_TOLERANCE_MM;
 use dressform::mesh::{Mesh, smooth::DEFAULT_PASSES};
 use dressform::output::OutputSet;
+use dressform::reconstruct::ReconstructOptions;
 use dressform::report::ScanInfo;
 use dressform::scan::format::{Export, Format, Placement};
 use dressform::scan::{self, frame::FrameOptions, frame::Units};
 use glam::DVec3;
-use sim::capture::{Artifacts, BodyParams, capture, generate};
+use sim::capture::{Artifacts, BodyParams, Pose, capture, generate};
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
@@ -29,9 +33,26 @@ pub struct DemoArgs {
     seed: Option<u64>,
 }
 
+/// How much further out the customer holds the left arm than the right (degrees of
+/// abduction): issue 15's example of a customer standing carelessly, which without pose
+/// symmetry makes the chest 24-338 mm too big.
+const ARM_FURTHER_OUT_DEG: f64 = 15.0;
+/// How much further out the customer stands on the right leg (degrees): issue 15's example; a
+/// leg 6 degrees out made the shape symmetry alone fail.
+const LEG_FURTHER_OUT_DEG: f64 = 5.0;
+
+/// `pose` with the left arm [`ARM_FURTHER_OUT_DEG`] and the right leg [`LEG_FURTHER_OUT_DEG`]
+/// further out.
+fn asymmetric(mut pose: Pose) -> Pose {
+    pose.left_arm.abduction_deg += ARM_FURTHER_OUT_DEG;
+    pose.right_leg.abduction_deg += LEG_FURTHER_OUT_DEG;
+    pose
+}
+
 pub fn run(args: &DemoArgs) -> Result<(), Failure> {
     let bar = progress_bar(false, 3);
     let params = args.seed.map_or_else(BodyParams::default, BodyParams::random);
+    let params = BodyParams { pose: asymmetric(params.pose), ..params };
     bar.set_message("generating the customer");
     let customer = generate(&params).map_err(Failure::other)?;
     bar.inc(1);
@@ -65,6 +86,14 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         truth.hip.tape_girth_mm,
         truth.crotch_height_mm
     );
+    let pose = &params.pose;
+    outln!(
+        "It stands with the left arm {:.0} degrees out and the right {:.0}, the left leg {:.0} and the right {:.0}.",
+        pose.left_arm.abduction_deg,
+        pose.right_arm.abduction_deg,
+        pose.left_leg.abduction_deg,
+        pose.right_leg.abduction_deg
+    );
     outln!(
         "Scanned with {:.1} mm noise, holes at the armpits, crotch and soles, in metres, Y up, turned {:.0} degrees:",
         artifacts.noise_sigma_mm,
@@ -78,24 +107,44 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         options: &DriveOptions::default(),
         girth_tolerance: DEFAULT_GIRTH_TOLERANCE_MM,
     };
-    let (result, shape) =
-        shape_form(&scan, &form_description::reference(), &drive, &args.out, outputs)?;
+    let model = BodyModel::builtin();
+    let reconstruct = Reconstruct { model: &model, options: &ReconstructOptions::default() };
+    let form = form_description::reference();
+    let (done, shape) = shape_form(&scan, &reconstruct, &form, &drive, &args.out, outputs)?;
     outln!();
-    outln!("  {:<12} {:>9} {:>9} {:>11}", "measure (mm)", "customer", "scan", "mannequin");
-    let c = &result.comparison;
-    outln!("  {:<12} {:>9.1} {:>9.1} {:>11}", "height", truth.height_mm, c.input.height, "-");
-    for (row, asked) in c.table.iter().zip([truth.chest, truth.waist, truth.hip]) {
+    outln!(
+        "  {:<12} {:>9} {:>9} {:>11} {:>11}",
+        "measure (mm)",
+        "customer",
+        "scan",
+        "pose-symm.",
+        "mannequin"
+    );
+    let c = &done.shaped.symmetrized.comparison;
+    let scanned = done.reposed.scan_measurements.as_ref();
+    let mm = |g: Option<f64>| g.map_or_else(|| "-".to_string(), |g| format!("{g:.1}"));
+    outln!(
+        "  {:<12} {:>9.1} {:>9} {:>11.1} {:>11}",
+        "height",
+        truth.height_mm,
+        mm(scanned.map(|m| m.height)),
+        c.input.height,
+        "-"
+    );
+    let three = done.reposed.measurements(c).table;
+    for (row, asked) in three.iter().zip([truth.chest, truth.waist, truth.hip]) {
         outln!(
-            "  {:<12} {:>9.1} {:>9.1} {:>11.1}",
+            "  {:<12} {:>9.1} {:>9} {:>11.1} {:>11.1}",
             row.measure,
             asked.tape_girth_mm,
-            row.input.tape,
+            mm(row.scan.map(|g| g.tape)),
+            row.pose_symmetric.tape,
             row.mannequin.tape
         );
     }
     outln!();
     outln!(
-        "Written to {}: scan.ply, mannequin.obj, profiles.json, measurements.json, setpoints.json, preview.png (a picture of the scan and the mannequin), sections.svg",
+        "Written to {}: scan.ply, posed.obj (the scan re-posed symmetric), rigged.glb, fit.json, mannequin.obj, profiles.json, measurements.json, setpoints.json, preview.png (the scan, the pose-symmetric scan and the mannequin), sections.svg",
         args.out.display()
     );
     shape_verdict(&shape)

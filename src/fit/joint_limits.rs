@@ -46,9 +46,12 @@ const RANGES_DEG: [(&str, [(f64, f64); 3]); 20] = [
     // Shoulder: flexion 180 / extension 60, abduction to 180 from the A-pose's 45 out and
     // adduction to the side, rotation 90.
     ("upperarm01.L", [(-180.0, 60.0), (-135.0, 45.0), (-90.0, 90.0)]),
-    // Elbow: flexion 150 (forwards, -X), no hyperextension; the forearm's 90 of pronation and
-    // supination about its length, which in the A-pose lies between Y and Z.
-    ("lowerarm01.L", [(-150.0, 0.0), (-90.0, 90.0), (-90.0, 90.0)]),
+    // Elbow: flexion 150 (forwards, -X), extension back to a straight arm; the forearm's 90 of
+    // pronation and supination about its length, which in the A-pose lies between Y and Z.
+    // The model's rest elbow is already bent 46.6 degrees about an axis whose X share is 0.76
+    // (the mean body's joints, upperarm01 -> lowerarm01 -> wrist), so straightening it is
+    // +35 about X: customers scan with nearly straight arms (the sim generator's A-pose: 10).
+    ("lowerarm01.L", [(-150.0, 35.0), (-90.0, 90.0), (-90.0, 90.0)]),
     // Wrist: flexion 80 / extension 70, radial 20 / ulnar 30 deviation, no twist of its own.
     ("wrist.L", [(-80.0, 70.0), (-30.0, 30.0), (-20.0, 20.0)]),
     // Hip: flexion 120 (forwards, -X) / extension 30, abduction 45 (-Y) / adduction 30,
