@@ -10,9 +10,11 @@
 //! off the torso at the armholes ([`Armhole`]), as a dress form's arm plates cut them.
 
 mod armhole;
+mod contact;
 mod tracking;
 
 pub use armhole::Armhole;
+pub use contact::Contact;
 
 use crate::mesh::Mesh;
 use crate::slice::{Contour, Section, sections};
