@@ -55,6 +55,12 @@ impl Armhole {
         Armhole { armpit, shoulder_point, normal, contact: None }
     }
 
+    /// Below this height the arm's loop is apart from the torso's: the bottom of the contact
+    /// for an arm resting on the torso, else the armpit.
+    pub fn arm_apart_below(&self) -> f64 {
+        self.contact.map_or(self.armpit.z, |c| c.from)
+    }
+
     /// This armhole, with the arm resting on the torso below the armpit along `contact`.
     pub fn with_contact(self, contact: Contact) -> Armhole {
         Armhole { contact: Some(contact), ..self }
