@@ -4,7 +4,8 @@
 //! leg 3-8 degrees out, the spine bent sideways 3-6 degrees, the head turned), one arm at
 //! 90 degrees, one arm resting on the torso, the legs together (thighs touching) and the legs
 //! 15 degrees out. Every body segments; every girth is within 2 mm of the generator's truth;
-//! no torso section holds arm material. The worst case of each stance is printed.
+//! no torso section holds arm material; every armpit lies within 10 mm of the generator's
+//! (15 mm for an arm held out horizontally). The worst case of each stance is printed.
 
 use crate::common::{mesh_of, uniform};
 use dressform::measure::{levels, measure_at};
@@ -30,6 +31,15 @@ const BLEND_MM: f64 = (25.0 + 18.0 + 18.0) / 4.0;
 /// may lie above the armpits (mm): the detected shoulder point differs from the design point
 /// by up to 25 mm on gradually rounded shoulders, which tilts the plate by a few degrees.
 const PLATE_MM: f64 = 15.0;
+
+/// How far a found armpit may lie from the generator's design armpit (mm). An arm resting on
+/// the torso hides its armpit in the contact; the rule that finds it there
+/// (`dressform::regions::Contact`) lands within 9 mm of the design point.
+const ARMPIT_TOLERANCE_MM: f64 = 10.0;
+/// The same for an arm held out horizontally: it grows out of the torso's side with no loop
+/// of its own below, and its armpit is the crease where the side's reach jumps, up to 15 mm
+/// below the design point on the generator's heaviest shoulders.
+const HORIZONTAL_ARMPIT_TOLERANCE_MM: f64 = 15.0;
 
 /// Each leg's abduction when the legs stand together: the generator's least, where the
 /// thighs (8 mm apart at the hip joints' level) are blended together below the crotch.
@@ -93,6 +103,8 @@ struct Outcome {
     girth_error: (f64, &'static str),
     /// How far past the allowance, and at what height.
     arm_material: (f64, f64),
+    /// The found armpits' heights less the generator's (mm): left, right.
+    armpits: [f64; 2],
 }
 
 fn check(stance: Stance, seed: u64) -> Result<Outcome, String> {
@@ -141,7 +153,11 @@ fn check(stance: Stance, seed: u64) -> Result<Outcome, String> {
             }
         }
     }
-    Ok(Outcome { seed, girth_error, arm_material })
+    let armpits = [
+        lm.left_armpit - t.landmarks.left.armpit[2],
+        lm.right_armpit - t.landmarks.right.armpit[2],
+    ];
+    Ok(Outcome { seed, girth_error, arm_material, armpits })
 }
 
 fn run_stance(stance: Stance) {
@@ -152,8 +168,11 @@ fn run_stance(stance: Stance) {
     let worst_girth =
         ok.iter().max_by(|a, b| a.girth_error.0.abs().total_cmp(&b.girth_error.0.abs()));
     let worst_arm = ok.iter().max_by(|a, b| a.arm_material.0.total_cmp(&b.arm_material.0));
+    let armpit_errors = ok.iter().flat_map(|o| o.armpits);
+    let (low, high) = armpit_errors.fold((f64::MAX, f64::MIN), |(l, h), e| (l.min(e), h.max(e)));
     println!(
-        "{stance:?}: {} of {BODIES} segmented; worst girth {}; worst arm material {}",
+        "{stance:?}: {} of {BODIES} segmented; worst girth {}; worst arm material {}; \
+         armpits {low:+.1} to {high:+.1} mm from the truth",
         ok.len(),
         worst_girth.map_or("-".into(), |o| format!(
             "{:+.2} mm ({}, seed {})",
@@ -165,7 +184,12 @@ fn run_stance(stance: Stance) {
         )),
     );
     assert!(failures.is_empty(), "{stance:?}: {failures:#?}");
+    let armpit_tolerance = match stance {
+        Stance::OneArmHorizontal => HORIZONTAL_ARMPIT_TOLERANCE_MM,
+        _ => ARMPIT_TOLERANCE_MM,
+    };
     for o in &ok {
+        assert!(o.armpits.iter().all(|e| e.abs() <= armpit_tolerance), "{stance:?}: {o:?}");
         assert!(o.girth_error.0.abs() <= GIRTH_TOLERANCE_MM, "{stance:?}: {o:?}");
         assert!(o.arm_material.0 <= 0.0, "{stance:?}: {o:?}");
     }
@@ -187,13 +211,6 @@ fn one_arm_horizontal() {
 }
 
 #[test]
-#[ignore = "not yet: all 20 segment and girths hold (worst -0.32 mm), but the resting arm \
-            touches the torso from 17 mm below the generator's armpit up to it (seed 15: \
-            apart up to 1350 mm, one loop from 1360; the truth's armpit 1371.3), so slicing \
-            finds the armpit where they touch, the plate tilts and leaves material 0.6 mm \
-            past the allowance at z = 1370. Splitting a touching loop at its pinch needs an \
-            armpit rule for touching arms (where the pinch vanishes also moves an A-posed \
-            arm's armpit up), not written yet"]
 fn an_arm_resting_on_the_torso() {
     run_stance(Stance::ArmResting);
 }

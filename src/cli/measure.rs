@@ -3,7 +3,8 @@
 
 use super::{Failure, FrameArgs, SmoothArgs, warn};
 use dressform::measure::{
-    BodyDimensions, Girth, Levels, Measurements, dimensions, find_levels, measure_at, warnings,
+    BodyDimensions, Girth, Levels, Measurements, contact_warnings, dimensions, find_levels,
+    measure_at, warnings,
 };
 use dressform::regions::Landmarks;
 use dressform::scan;
@@ -97,6 +98,7 @@ fn measure_one(path: &Path, args: &MeasureArgs) -> Result<MeasureOut, Failure> {
     let measurements = measure_at(&body, &levels);
     let dimensions = dimensions(&body, &levels);
     let mut warnings = warnings(&scan.body, &levels);
+    warnings.extend(contact_warnings(body.landmarks(), &levels));
     warnings.extend(fallbacks);
     let at = body
         .torso_sections(&args.at)

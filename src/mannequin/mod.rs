@@ -113,11 +113,13 @@ fn symmetric_landmarks(m: &Landmarks, axis: f64) -> Landmarks {
         armpit: 0.5 * (l.armpit + mirror(r.armpit)),
         shoulder_point: 0.5 * (l.shoulder_point + mirror(r.shoulder_point)),
         normal: (l.normal + flip(r.normal)).normalize_or(l.normal),
+        contact: None,
     };
     let right = Armhole {
         armpit: mirror(left.armpit),
         shoulder_point: mirror(left.shoulder_point),
         normal: flip(left.normal),
+        contact: None,
     };
     Landmarks {
         left_armpit: left.armpit.z,

@@ -70,16 +70,16 @@ pub fn arms(body: &SegmentedBody) -> [Option<ArmMeasures>; 2] {
     let m = body.landmarks();
     [(Region::LeftArm, &m.left_armhole), (Region::RightArm, &m.right_armhole)].map(
         |(region, armhole)| {
-            let loops = arm_loops(body, region, armhole.armpit.z);
+            let loops = arm_loops(body, region, armhole.arm_apart_below());
             measure_arm(body.mesh(), &loops, armhole.shoulder_point, m.height)
         },
     )
 }
 
-/// The arm's loops from just below its armpit down to its end, with their heights.
-fn arm_loops(body: &SegmentedBody, region: Region, armpit: f64) -> Vec<(f64, Contour)> {
-    let zs: Vec<f64> =
-        (1..).map(|k| armpit - STEP_MM * k as f64).take_while(|&z| z > 0.0).collect();
+/// The arm's loops from just below `apart` (where it leaves the torso) down to its end, with
+/// their heights.
+fn arm_loops(body: &SegmentedBody, region: Region, apart: f64) -> Vec<(f64, Contour)> {
+    let zs: Vec<f64> = (1..).map(|k| apart - STEP_MM * k as f64).take_while(|&z| z > 0.0).collect();
     body.sections_of(region, &zs)
         .into_iter()
         .zip(&zs)

@@ -43,6 +43,7 @@ pub use neck_and_shoulders::{
 pub use plane::{PlaneLoop, tape_arc};
 
 use crate::mesh::Mesh;
+use crate::regions::{Armhole, Landmarks};
 use crate::segmented_body::SegmentedBody;
 use crate::slice::{Contour, sections};
 use serde::Serialize;
@@ -286,6 +287,31 @@ pub fn warnings(body: &Mesh, levels: &Levels) -> Vec<String> {
         .collect()
 }
 
+/// Where a girth at `levels` is taken across an arm resting on the torso: between where the
+/// arm's loop joins the torso's and its armpit ([`crate::regions::Contact`]) the torso is cut
+/// off the arm along the crease between them, where a tape passed under the arm would lie,
+/// but the arm may press the torso in there.
+pub fn contact_warnings(landmarks: &Landmarks, levels: &Levels) -> Vec<String> {
+    let sides = [("left", &landmarks.left_armhole), ("right", &landmarks.right_armhole)];
+    let resting = sides
+        .into_iter()
+        .filter_map(|(side, a): (_, &Armhole)| a.contact.map(|c| (side, c.from, a.armpit.z)));
+    let mut out = Vec::new();
+    for (side, from, armpit) in resting {
+        for (name, z) in [("chest", levels.chest), ("waist", levels.waist), ("hip", levels.hip)] {
+            if (from..armpit).contains(&z) {
+                out.push(format!(
+                    "the {side} arm rests on the torso from {from:.0} to {armpit:.0} mm: the \
+                     {name} girth at z = {z:.0} mm is cut off the arm along the crease between \
+                     them; scan with the arms 10 degrees or more from the body for a girth \
+                     clear of the arm"
+                ));
+            }
+        }
+    }
+    out
+}
+
 /// Measures `body` at `levels`, on its torso's loops.
 pub fn measure_at(body: &SegmentedBody, levels: &Levels) -> Measurements {
     let zs = [levels.chest, levels.waist, levels.hip];
@@ -316,4 +342,42 @@ pub fn central_loops(mesh: &Mesh, axis: f64, heights: &[f64]) -> Vec<Option<Cont
             s.loops.iter().find(straddles).cloned()
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::regions::Contact;
+    use glam::{DVec2, DVec3};
+
+    #[test]
+    fn a_girth_across_a_resting_arm_is_warned() {
+        let armhole = |side: f64| {
+            Armhole::through(
+                DVec3::new(side * 150.0, 0.0, 1300.0),
+                DVec3::new(side * 190.0, 0.0, 1420.0),
+                DVec3::NEG_Y,
+                side,
+            )
+        };
+        // The right arm rests on the torso from 1270 mm up to its armpit at 1300 mm.
+        let contact = Contact { from: 1270.0, normal: DVec2::NEG_X, offset: 150.0 };
+        let landmarks = Landmarks {
+            height: 1700.0,
+            crotch: 800.0,
+            ankle: 90.0,
+            left_armpit: 1300.0,
+            right_armpit: 1300.0,
+            neck: 1450.0,
+            centre_x: 0.0,
+            left_armhole: armhole(1.0),
+            right_armhole: armhole(-1.0).with_contact(contact),
+        };
+        let at = |chest: f64| Levels { chest, waist: 1050.0, hip: 900.0 };
+        assert!(contact_warnings(&landmarks, &at(1260.0)).is_empty(), "below the contact");
+        let warned = contact_warnings(&landmarks, &at(1280.0));
+        assert_eq!(warned.len(), 1, "{warned:?}");
+        assert!(warned[0].contains("right arm rests on the torso from 1270 to 1300 mm"));
+        assert!(warned[0].contains("chest girth at z = 1280 mm"), "{}", warned[0]);
+    }
 }

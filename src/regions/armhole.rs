@@ -12,6 +12,7 @@
 //! shoulder cap into the arm's side), an A-pose (it bends into the arm's upper side) and a
 //! raised arm (the notch where the arm begins, below the chord instead of above it).
 
+use super::contact::Contact;
 use crate::mesh::Mesh;
 use crate::slice::Contour;
 use glam::{DVec2, DVec3};
@@ -38,6 +39,10 @@ pub struct Armhole {
     /// Unit normal of the arm plate's plane (through both points), pointing away from the
     /// torso, into the arm.
     pub normal: DVec3,
+    /// Where the arm rests on the torso below the armpit, if it does: there the torso is
+    /// cut off the arm along the crease between them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact: Option<Contact>,
 }
 
 impl Armhole {
@@ -47,7 +52,18 @@ impl Armhole {
     pub fn through(armpit: DVec3, shoulder_point: DVec3, front: DVec3, side: f64) -> Armhole {
         let n = (shoulder_point - armpit).cross(front).normalize_or(DVec3::X);
         let normal = if n.x * side < 0.0 { -n } else { n };
-        Armhole { armpit, shoulder_point, normal }
+        Armhole { armpit, shoulder_point, normal, contact: None }
+    }
+
+    /// Below this height the arm's loop is apart from the torso's: the bottom of the contact
+    /// for an arm resting on the torso, else the armpit.
+    pub fn arm_apart_below(&self) -> f64 {
+        self.contact.map_or(self.armpit.z, |c| c.from)
+    }
+
+    /// This armhole, with the arm resting on the torso below the armpit along `contact`.
+    pub fn with_contact(self, contact: Contact) -> Armhole {
+        Armhole { contact: Some(contact), ..self }
     }
 
     /// How far `p` lies beyond the arm plate, into the arm (negative on the torso's side).
@@ -58,10 +74,16 @@ impl Armhole {
     }
 
     /// The part of the horizontal loop `c` at height `z` on the torso's side of the plate;
-    /// below the armpit the loop is returned whole.
+    /// below the armpit the loop is returned whole, or, where the arm rests on the torso,
+    /// cut along the contact.
     pub fn clip(&self, c: &Contour, z: f64) -> Contour {
         if z < self.armpit.z {
-            return c.clone();
+            return match self.contact {
+                Some(contact) if z >= contact.from => {
+                    c.clip_half_plane(contact.normal, contact.offset)
+                }
+                _ => c.clone(),
+            };
         }
         // In the plane at z: beyond(p) = n.xy . p.xy + (n.z z' - n . armpit) <= 0.
         let zc = z.min(self.shoulder_point.z);

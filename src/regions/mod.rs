@@ -10,9 +10,11 @@
 //! off the torso at the armholes ([`Armhole`]), as a dress form's arm plates cut them.
 
 mod armhole;
+mod contact;
 mod tracking;
 
 pub use armhole::Armhole;
+pub use contact::Contact;
 
 use crate::mesh::Mesh;
 use crate::slice::{Contour, Section, sections};
@@ -63,10 +65,11 @@ pub struct Landmarks {
     /// The narrowest level of the legs near the floor (the ankles): where the legs end.
     #[serde(rename = "ankle_mm")]
     pub ankle: f64,
-    /// Where the left arm joins the torso: the height of `left_armhole.armpit`.
+    /// The left armpit's height (`left_armhole.armpit`): where the arm's loop joins the
+    /// torso's going up or, for an arm resting on the torso, the top of the contact.
     #[serde(rename = "left_armpit_mm")]
     pub left_armpit: f64,
-    /// Where the right arm joins the torso: the height of `right_armhole.armpit`.
+    /// The right armpit's height (`right_armhole.armpit`), as the left's.
     #[serde(rename = "right_armpit_mm")]
     pub right_armpit: f64,
     /// The narrowest torso level between the armpits and the head.

@@ -1,6 +1,7 @@
 //! Tracking loops from level to level to find the landmarks and label every loop.
 
 use super::armhole::{self, Armhole};
+use super::contact::{Contact, Neck, NeckGauge};
 use super::{BodyRegions, LabelledSection, Landmarks, Region, RegionError, side};
 use crate::mesh::Mesh;
 use crate::slice::{Contour, Section, sections};
@@ -99,6 +100,49 @@ fn refine_armpit(
     }
     let (p, q) = armhole::closest_points(&apart.0, &apart.1);
     (0.5 * (p + q)).extend(above)
+}
+
+/// The armpit of an arm that rests on the torso (see [`super::contact`]): going up the
+/// torso's tracked loops `up` from the join (arm `arm` apart from the torso's loop on level
+/// `join.level`, joined from `joined` mm), the first level where the neck between them has
+/// opened, refined by bisection to 0.1 mm; `None` when the neck is open on the first joined
+/// level (an arm that leaves the torso at an angle: its armpit is where the loops join).
+fn top_of_contact(
+    body: &Mesh,
+    levels: &[Section],
+    grid: Grid,
+    up: &[(usize, usize)],
+    join: &ArmJoin,
+    arm: &Contour,
+    joined: f64,
+) -> Option<(DVec3, Contact)> {
+    let torso = &levels[join.level].loops[join.torso];
+    let gauge = NeckGauge::between(torso, arm);
+    let neck_of = |c: &Contour| gauge.neck(c);
+    let above: Vec<&(usize, usize)> = up.iter().filter(|&&(i, _)| i > join.level).collect();
+    let first_open =
+        above.iter().position(|&&(i, k)| gauge.is_open(neck_of(&levels[i].loops[k])))?;
+    if first_open == 0 {
+        return None;
+    }
+    let (closed_level, closed_loop) = *above[first_open - 1];
+    let mut closed: Neck = neck_of(&levels[closed_level].loops[closed_loop])?;
+    let (mut below, mut top) = (grid.z(closed_level), grid.z(above[first_open].0));
+    let near = between(body, below, top);
+    let centre = torso.centroid();
+    while top - below > 0.1 {
+        let mid = 0.5 * (below + top);
+        let s = &sections(&near, &[mid])[0];
+        let neck = loop_containing(s, centre).and_then(|t| neck_of(&s.loops[t]));
+        match neck.filter(|_| !gauge.is_open(neck)) {
+            Some(n) => {
+                closed = n;
+                below = mid;
+            }
+            None => top = mid,
+        }
+    }
+    Some((closed.centre.extend(top), gauge.contact(&closed, joined)))
 }
 
 /// How an arm joins the torso's loop going up.
@@ -344,31 +388,40 @@ pub(super) fn track(
     // The centre line: the torso's bounding-box centre just below the lower armpit.
     let lower = if left.level <= right.level { left } else { right };
     let centre_x = sections[lower.level].loops[lower.torso].bbox_centre().x;
+    // Each armpit, and where its arm rests on the torso below it if it does.
     let armpit_point = |join: ArmJoin, sign: f64| {
         let (i, torso_loop) = (join.level, &sections[join.level].loops[join.torso]);
         match join.how {
             Join::Loop(k) => {
-                refine_armpit(body, grid.z(i), grid.z(i + 1), &sections[i].loops[k], torso_loop)
+                let arm = &sections[i].loops[k];
+                let pit = refine_armpit(body, grid.z(i), grid.z(i + 1), arm, torso_loop);
+                match top_of_contact(body, &sections, grid, &up, &join, arm, pit.z) {
+                    Some((top, contact)) => (top, Some(contact)),
+                    None => (pit, None),
+                }
             }
-            Join::Outgrowth => refine_outgrowth(body, grid.z(i), grid.z(i + 1), torso_loop, sign),
+            Join::Outgrowth => {
+                (refine_outgrowth(body, grid.z(i), grid.z(i + 1), torso_loop, sign), None)
+            }
         }
     };
     let (left_pit, right_pit) = (armpit_point(left, 1.0), armpit_point(right, -1.0));
-    let neck = neck_level(&sections, grid, &up, left_pit.z.max(right_pit.z));
+    let neck = neck_level(&sections, grid, &up, left_pit.0.z.max(right_pit.0.z));
     let ankle = ankle_level(&sections, grid, &legs);
 
     // Armholes: through each armpit and its shoulder point, facing sideways.
-    let armhole = |pit: DVec3, sign: f64, name: &'static str| {
+    let armhole = |(pit, contact): (DVec3, Option<Contact>), sign: f64, name: &'static str| {
         let shoulder = armhole::shoulder_point(body, sign, centre_x, pit, neck)
             .ok_or(RegionError::NoArm { side: name })?;
-        Ok(Armhole::through(pit, shoulder, DVec3::NEG_Y, sign))
+        let plate = Armhole::through(pit, shoulder, DVec3::NEG_Y, sign);
+        Ok(contact.map_or(plate, |c| plate.with_contact(c)))
     };
     let landmarks = Landmarks {
         height,
         crotch,
         ankle,
-        left_armpit: left_pit.z,
-        right_armpit: right_pit.z,
+        left_armpit: left_pit.0.z,
+        right_armpit: right_pit.0.z,
         neck,
         centre_x,
         left_armhole: armhole(left_pit, 1.0, "left")?,

@@ -13,7 +13,7 @@ pub struct Contour {
 
 impl Contour {
     /// The loop's edges as point pairs, including the closing edge.
-    fn edges(&self) -> impl Iterator<Item = (DVec2, DVec2)> + '_ {
+    pub(crate) fn edges(&self) -> impl Iterator<Item = (DVec2, DVec2)> + '_ {
         let n = self.points.len();
         (0..n).map(move |i| (self.points[i], self.points[(i + 1) % n]))
     }
