@@ -115,6 +115,9 @@ fn an_stl_mannequin_has_no_header_and_is_refused_clearly() {
     assert_eq!(code, 2, "{stderr}");
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
     assert!(stderr.contains("read a mannequin from the OBJ, PLY or glb file"), "{stderr}");
+    // What was seen: no arm between mid-torso and the chin, with the heights searched.
+    assert!(stderr.contains("arm beside the torso from "), "{stderr}");
+    assert!(stderr.contains(" mm (the chin)"), "{stderr}");
 }
 
 #[test]

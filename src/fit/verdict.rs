@@ -1,9 +1,9 @@
 //! Did the fit converge? The residual per body region: for each model vertex, its distance to
 //! the nearest scan point, and per region (torso, head, each arm, each leg) the median over the
 //! region's vertices. A region whose median is above [`MAX_REGION_MEDIAN_MM`] (the torso:
-//! [`MAX_TORSO_MEDIAN_MM`]) is not on the scan: a limb matched to the wrong place, or a scan that is no whole body (a sphere, a box,
-//! the upper half of a body). The median ignores holes, which leave a minority of a region's
-//! vertices far from the scan.
+//! [`MAX_TORSO_MEDIAN_MM`]) is not on the scan: a limb matched to the wrong place, or a scan
+//! that is no whole body (a sphere, a box, the upper half of a body). The median ignores
+//! holes, which leave a minority of a region's vertices far from the scan.
 
 use super::Fit;
 use crate::body_model::BodyModel;

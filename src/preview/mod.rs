@@ -207,9 +207,13 @@ fn preview_rgb(bodies: &[(&Mesh, &str)], result: &Symmetrized) -> (usize, usize,
 
     let mut panels = Vec::with_capacity(shown.len() * VIEWS.len());
     for view in &VIEWS {
-        for &(mesh, normals, colour, levels) in &shown {
+        for (&(mesh, normals, colour, levels), name) in shown.iter().zip(&names) {
             let (lo, hi) = extent(mesh, view);
-            let width = ((hi - lo) * scale + 2.0 * PAD_PX).ceil() as usize;
+            // As wide as the body, or as its label where that is wider (a body seen from the
+            // side is narrower than "pose-symmetric").
+            let body_px = (hi - lo) * scale;
+            let label_px = (name.len() * raster::GLYPH_PX) as f64;
+            let width = (body_px.max(label_px) + 2.0 * PAD_PX).ceil() as usize;
             panels.push(Panel { mesh, normals, colour, levels, heights, view, left_mm: lo, width });
         }
     }

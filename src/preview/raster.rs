@@ -124,6 +124,9 @@ impl Canvas {
     }
 }
 
+/// Width of one character of [`text`] at scale 1 (pixels): font8x8's glyphs are 8 x 8.
+pub const GLYPH_PX: usize = 8;
+
 /// Writes `text` into the 8-bit RGB image `rgb` (`width` pixels wide) with its top-left
 /// corner at (x, y), each font pixel `scale` pixels wide, in the 8×8 font of the `font8x8`
 /// crate (Basic Latin; other characters are left blank).
@@ -138,8 +141,8 @@ pub fn text(
     for (k, ch) in text.chars().enumerate() {
         let glyph = font8x8::legacy::BASIC_LEGACY.get(ch as usize).copied().unwrap_or([0; 8]);
         for (row, bits) in glyph.iter().enumerate() {
-            for col in (0..8).filter(|col| bits >> col & 1 == 1) {
-                let at = (x + (k * 8 + col) * scale, y + row * scale);
+            for col in (0..GLYPH_PX).filter(|col| bits >> col & 1 == 1) {
+                let at = (x + (k * GLYPH_PX + col) * scale, y + row * scale);
                 fill(rgb, width, at, (scale, scale), colour);
             }
         }

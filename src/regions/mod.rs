@@ -128,14 +128,29 @@ pub enum RegionError {
         /// The loops found there.
         loops: usize,
     },
-    /// No arm loop below the armpits on one side.
+    /// No arm joins the torso on one side between mid-torso and the chin.
     #[error(
-        "no {side} arm found beside the torso (arms must hang clear of it, as in an A-pose; \
-         read a mannequin from the OBJ, PLY or glb file dressform wrote)"
+        "no {side} arm beside the torso from {from:.0} to {to:.0} mm (the chin): hold the arms \
+         10-90 degrees out; read a mannequin from the OBJ, PLY or glb file dressform wrote"
     )]
     NoArm {
         /// "left" or "right".
         side: &'static str,
+        /// Where the search began (mm): mid-torso.
+        from: f64,
+        /// Where it ended (mm): the chin.
+        to: f64,
+    },
+    /// No shoulder on one side above the armpit.
+    #[error(
+        "no {side} shoulder found above the armpit at {armpit:.0} mm: the front silhouette has \
+         no edge between the neck and the arm there (is the arm raised above the shoulder?)"
+    )]
+    NoShoulder {
+        /// "left" or "right".
+        side: &'static str,
+        /// The armpit's height (mm).
+        armpit: f64,
     },
 }
 

@@ -382,7 +382,11 @@ pub(super) fn track(
 
     let chin = grid.at(CHIN_LEVEL);
     let arm = |sign: f64, side: &'static str| {
-        arm_join(&sections, &up, chin, sign).ok_or(RegionError::NoArm { side })
+        arm_join(&sections, &up, chin, sign).ok_or(RegionError::NoArm {
+            side,
+            from: grid.z(seed),
+            to: grid.z(chin),
+        })
     };
     let (left, right) = (arm(1.0, "left")?, arm(-1.0, "right")?);
     // The centre line: the torso's bounding-box centre just below the lower armpit.
@@ -412,7 +416,7 @@ pub(super) fn track(
     // Armholes: through each armpit and its shoulder point, facing sideways.
     let armhole = |(pit, contact): (DVec3, Option<Contact>), sign: f64, name: &'static str| {
         let shoulder = armhole::shoulder_point(body, sign, centre_x, pit, neck)
-            .ok_or(RegionError::NoArm { side: name })?;
+            .ok_or(RegionError::NoShoulder { side: name, armpit: pit.z })?;
         let plate = Armhole::through(pit, shoulder, DVec3::NEG_Y, sign);
         Ok(contact.map_or(plate, |c| plate.with_contact(c)))
     };
