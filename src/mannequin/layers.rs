@@ -11,6 +11,39 @@ use glam::DVec2;
 /// crotch the torso loop is just forming.
 const CROTCH_CLEARANCE_MM: f64 = 1.0;
 
+/// The legs' mesh rings are about this far apart next to the crotch (mm): the torso's layers
+/// are 6-8 mm apart there at the paper's 100. At 2 mm (the height of the band joining the legs
+/// to the torso) the rings sampled the thin inner-back corner of the leg sections just below
+/// the MakeHuman body's crotch, and neighbouring rings crossed there.
+const FINE_NEXT_MM: f64 = 4.0;
+
+/// Within this distance below the crotch (mm) the legs' mesh has rings between their layers,
+/// spaced from [`FINE_NEXT_MM`] at the crotch growing linearly to the layers' own spacing
+/// (13-15 mm at the paper's 50 layers). The gluteal fold under the buttocks reaches 75 mm
+/// below the crotch on the generator's bodies (random-2); sampled by the leg layers alone its
+/// turn fell on single rings, creased 8-13 degrees: a shaded line across the back of the
+/// thighs; and the legs' coarse rings met the torso's finer ones with a kink.
+const FINE_DEPTH_MM: f64 = 100.0;
+
+/// The heights of the legs' mesh rings among their layers at `layer_z` (increasing), each with
+/// whether it is a layer: the layers, and each interval between two of them whose middle lies
+/// within [`FINE_DEPTH_MM`] of the crotch at `crotch` split evenly into parts about as high as
+/// the spacing wanted there (see [`FINE_DEPTH_MM`]). The rings between layers are the mesh's
+/// only, as the shoulder cap's are: the layers (`profiles.json`) are the paper's.
+fn mesh_rings(layer_z: &[f64], crotch: f64) -> Vec<(f64, bool)> {
+    let mut rings = Vec::with_capacity(layer_z.len());
+    for pair in layer_z.windows(2) {
+        let (lo, hi) = (pair[0], pair[1]);
+        let depth = (0.5 * (lo + hi) - crotch).abs();
+        let wanted = FINE_NEXT_MM + (hi - lo - FINE_NEXT_MM).max(0.0) * depth / FINE_DEPTH_MM;
+        let parts = if depth < FINE_DEPTH_MM { ((hi - lo) / wanted).ceil() as usize } else { 1 };
+        rings.push((lo, true));
+        rings.extend((1..parts).map(|k| (lo + (hi - lo) * k as f64 / parts as f64, false)));
+    }
+    rings.push((layer_z[layer_z.len() - 1], true));
+    rings
+}
+
 /// `count` heights evenly spaced from `lo` to `hi` inclusive.
 fn spaced(lo: f64, hi: f64, count: usize) -> Vec<f64> {
     (0..count).map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64).collect()
@@ -34,8 +67,12 @@ fn layer(region: Region, z: f64, centre: DVec2, points: Vec<DVec2>, input: &Cont
 pub(super) struct SymmetricLayers {
     pub axis: f64,
     pub torso: Vec<Layer>,
+    /// The legs' mesh rings, bottom to top: their layers and the rings between them near the
+    /// crotch ([`mesh_rings`]).
     pub left_leg: Vec<Layer>,
     pub right_leg: Vec<Layer>,
+    /// Whether each of the legs' rings is one of their layers.
+    pub is_layer: Vec<bool>,
 }
 
 /// The symmetry axis and the symmetric torso, left-leg and right-leg layers; the torso layers
@@ -56,7 +93,10 @@ pub(super) fn symmetric_layers(
             torso_z[k] = z;
         }
     }
-    let leg_z = spaced(m.ankle, m.crotch - CROTCH_CLEARANCE_MM, o.leg_layers);
+    let (leg_z, is_layer): (Vec<f64>, Vec<bool>) =
+        mesh_rings(&spaced(m.ankle, m.crotch - CROTCH_CLEARANCE_MM, o.leg_layers), m.crotch)
+            .into_iter()
+            .unzip();
 
     // Torso sections, with the arms cut off above the armpits.
     let torso_sections: Vec<(f64, Contour)> = torso_z
@@ -78,8 +118,8 @@ pub(super) fn symmetric_layers(
         })
         .collect::<Result<Vec<_>, MannequinError>>()?;
 
-    let mut left_leg = Vec::with_capacity(o.leg_layers);
-    let mut right_leg = Vec::with_capacity(o.leg_layers);
+    let mut left_leg = Vec::with_capacity(leg_z.len());
+    let mut right_leg = Vec::with_capacity(leg_z.len());
     for s in body.sections(&leg_z) {
         let labels = body.regions().label(&s);
         let find = |region| {
@@ -91,5 +131,5 @@ pub(super) fn symmetric_layers(
         left_leg.push(layer(Region::LeftLeg, s.height, lr.centre, lr.points, l));
         right_leg.push(layer(Region::RightLeg, s.height, rr.centre, rr.points, r));
     }
-    Ok(SymmetricLayers { axis, torso, left_leg, right_leg })
+    Ok(SymmetricLayers { axis, torso, left_leg, right_leg, is_layer })
 }

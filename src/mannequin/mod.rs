@@ -7,8 +7,10 @@
 //! torso: the cut edges stack into flat arm plates, each rimmed by one smooth curve
 //! ([`arm_plates`]). Every torso layer is horizontal and keeps
 //! its section's girth; above the arm plates the mesh is built from rings bent up over the
-//! shoulders, which follow the shoulder top with its own slope ([`shoulder_cap`]). The legs'
-//! top layers are eased into the hips above them ([`thighs`]), so the crotch join has no step.
+//! shoulders, which follow the shoulder top with its own slope ([`shoulder_cap`]). Within
+//! 100 mm below the crotch the legs' mesh has rings between their layers, finer towards the
+//! crotch ([`layers`]; mesh only, as the shoulder cap's). The legs' top rings are eased into
+//! the hips above them ([`thighs`]), so the crotch join has no step.
 //! All layers share one symmetry plane, x = `axis`: the median of the torso sections'
 //! bounding-box centres.
 
@@ -172,7 +174,7 @@ pub fn build(
         });
     }
     crate::symmetry::check_rays(options.rays)?;
-    let layers::SymmetricLayers { axis, torso, mut left_leg, mut right_leg } =
+    let layers::SymmetricLayers { axis, torso, mut left_leg, mut right_leg, is_layer } =
         layers::symmetric_layers(body, keep, options)?;
     let landmarks = *body.landmarks();
     let cap = shoulder_cap::build(body.mesh(), &landmarks, &torso, axis, options)?;
@@ -187,6 +189,16 @@ pub fn build(
         .collect();
     let mesh =
         rebuild::rebuild(&rings, cap.neck_centre, &left_leg, &right_leg, axis, landmarks.crotch);
+    // The legs' layers without the mesh's rings between them.
+    let layers_only = |rings: Vec<Layer>| -> Vec<Layer> {
+        rings
+            .into_iter()
+            .zip(&is_layer)
+            .filter(|(_, layer)| **layer)
+            .map(|(ring, _)| ring)
+            .collect()
+    };
+    let (left_leg, right_leg) = (layers_only(left_leg), layers_only(right_leg));
     Ok(Mannequin {
         axis,
         landmarks,

@@ -263,6 +263,14 @@ pub fn creases(
     mesh: &Mesh,
     counts: impl Fn([DVec3; 3], [DVec3; 3], [DVec3; 2]) -> bool,
 ) -> Vec<f64> {
+    edge_creases(mesh, counts).into_iter().map(|(_, deg)| deg).collect()
+}
+
+/// As [`creases`], each angle with its edge's two ends.
+pub fn edge_creases(
+    mesh: &Mesh,
+    counts: impl Fn([DVec3; 3], [DVec3; 3], [DVec3; 2]) -> bool,
+) -> Vec<([DVec3; 2], f64)> {
     let mut faces_of_edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
     for (t, tri) in mesh.triangles.iter().enumerate() {
         for k in 0..3 {
@@ -276,7 +284,7 @@ pub fn creases(
         .iter()
         .filter_map(|(&edge, faces)| match faces[..] {
             [s, t] if counts(mesh.corners(s), mesh.corners(t), ends(edge)) => {
-                Some(normal(s).dot(normal(t)).clamp(-1.0, 1.0).acos().to_degrees())
+                Some((ends(edge), normal(s).dot(normal(t)).clamp(-1.0, 1.0).acos().to_degrees()))
             }
             _ => None,
         })
