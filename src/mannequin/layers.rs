@@ -133,3 +133,33 @@ pub(super) fn symmetric_layers(
     }
     Ok(SymmetricLayers { axis, torso, left_leg, right_leg, is_layer })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_legs_mesh_rings_keep_every_layer_and_are_finer_towards_the_crotch() {
+        // The paper's 50 leg layers from the ankle (100 mm) to just below a crotch at 800 mm.
+        let crotch = 800.0;
+        let layer_z = spaced(100.0, crotch - CROTCH_CLEARANCE_MM, 50);
+        let rings = mesh_rings(&layer_z, crotch);
+        let kept: Vec<f64> = rings.iter().filter(|(_, l)| *l).map(|(z, _)| *z).collect();
+        assert_eq!(kept, layer_z, "the layers are the rings flagged as layers, in order");
+        let gaps: Vec<(f64, f64)> =
+            rings.windows(2).map(|w| (crotch - 0.5 * (w[0].0 + w[1].0), w[1].0 - w[0].0)).collect();
+        assert!(gaps.iter().all(|(_, g)| *g > 0.0), "rings increase");
+        let layer_gap = layer_z[1] - layer_z[0];
+        for (depth, gap) in gaps {
+            if depth > FINE_DEPTH_MM + layer_gap {
+                let one = (gap - layer_gap).abs() < 1e-9;
+                assert!(one, "a ring between layers {depth} mm below the crotch");
+            } else {
+                let wanted = FINE_NEXT_MM + (layer_gap - FINE_NEXT_MM) * depth / FINE_DEPTH_MM;
+                assert!(gap <= wanted + 0.5 * layer_gap, "{gap} mm apart {depth} mm below");
+            }
+        }
+        let top = rings.len() - 1;
+        assert!(rings[top].0 - rings[top - 1].0 < 1.25 * FINE_NEXT_MM, "finest at the crotch");
+    }
+}
