@@ -263,3 +263,22 @@ fn slice_labels_the_untouched_makehuman_body() {
         assert_eq!(labels, want, "at z = {}", section["z_mm"]);
     }
 }
+
+/// The stature is the crown's height above the floor (z = 0), not the body's extent: a sole
+/// below the floor (a foot that re-posing swung down with the sole a scanner left it) does not
+/// make the body taller.
+#[test]
+fn the_stature_is_the_crown_above_the_floor() {
+    let body = generate(&BodyParams::default()).unwrap();
+    let mesh = mesh_of(&body);
+    let standing = SegmentedBody::find(&mesh).unwrap().landmarks().height;
+    let crown = mesh.bounds().unwrap().max.z;
+    assert!((standing - crown).abs() < 1e-9, "{standing} against the crown's {crown}");
+    let sunk =
+        mesh.map_positions(|p| if p.z < 60.0 && p.x > 0.0 { p - DVec3::Z * 10.0 } else { p });
+    let sunk = SegmentedBody::find(&sunk).unwrap().landmarks().height;
+    assert!(
+        (sunk - standing).abs() < 1e-9,
+        "{sunk} with a sole 10 mm below the floor, {standing} standing"
+    );
+}

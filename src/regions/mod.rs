@@ -56,7 +56,11 @@ impl Region {
 /// Landmark heights (mm, canonical frame) and the armholes.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Landmarks {
-    /// Body height.
+    /// Body height, the stature: the crown's height above the floor, the frame's z = 0 (a
+    /// scan's lowest point when it was loaded; for the pose-symmetric scan, where the fitted
+    /// model's soles stand). Not the body's extent: a scanner cuts the soles at the floor,
+    /// and a foot lifted sideways keeps more of its sole, which re-posing swings 5-17 mm
+    /// below the floor (the demo's customer, MakeHuman bodies with a leg 3-14 degrees out).
     #[serde(rename = "height_mm")]
     pub height: f64,
     /// Where the legs join (to 0.1 mm): just above it the torso is one loop.

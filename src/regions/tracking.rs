@@ -421,7 +421,7 @@ pub(super) fn track(
         Ok(contact.map_or(plate, |c| plate.with_contact(c)))
     };
     let landmarks = Landmarks {
-        height,
+        height: floor + height,
         crotch,
         ankle,
         left_armpit: left_pit.0.z,
