@@ -293,7 +293,7 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
     assert!(status.success(), "remesh.py failed");
 
     let mut misses = Vec::new();
-    let mut worst = [0.0f64; 4];
+    let mut worst = [0.0f64; 5];
     for (i, (case, bodies)) in cases.iter().zip(&truths).enumerate() {
         let mut rng = ChaCha8Rng::seed_from_u64(2500 + i as u64);
         let remeshed = |name: &str| {
@@ -349,6 +349,8 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         let girth_err: Vec<f64> =
             girth_want.iter().zip(&girth_got).map(|(a, b)| (a - b).abs()).collect();
         let girth_mean = girth_err.iter().sum::<f64>() / 3.0;
+        let stature = |body: &Mesh| SegmentedBody::find(body).unwrap().landmarks().height;
+        let (stature_want, stature_got) = (stature(&truth.body), stature(&rec.reposed.posed.body));
 
         let mut row = format!(
             "case {i:2} {:?} {} {:.2} {frame_name} yaw {:+.0}: fit {:.1} s, {} it, rms {:.2}/{:.2} mm |",
@@ -374,7 +376,7 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
             }
         }
         row += &format!(
-            " | spine bend {:.1}/{bend:.1} twist {:.1}/{twist:.1} head {:.1}/{head:.1} | chest, waist, hip at {heights:.0?} (result's {:.0?}) {girth_want:.0?} off {girth_err:.1?} mm",
+            " | spine bend {:.1}/{bend:.1} twist {:.1}/{twist:.1} head {:.1}/{head:.1} | chest, waist, hip at {heights:.0?} (result's {:.0?}) {girth_want:.0?} off {girth_err:.1?} mm | stature {stature_want:.1}/{stature_got:.1}",
             case.spine_bend,
             case.spine_twist,
             case.head_turn,
@@ -396,6 +398,11 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
             }
         }
         worst[3] = worst[3].max(girth_err.iter().copied().fold(0.0, f64::max));
+        // The stature is printed, not checked: with the trunk straightened, the pose-symmetric
+        // scan reads 3.5-6.4 mm taller than the truth (the spine-bend and non-standard cases;
+        // within 1.4 elsewhere), beyond ISO 20685-1's 4 mm. Not explained yet: one suspect is
+        // the crown the scanner cut flat, tilted by the straightening.
+        worst[4] = worst[4].max((stature_got - stature_want).abs());
         if girth_err.iter().any(|&e| exceeds(e, GIRTH_TOLERANCE_MM))
             || exceeds(girth_mean, GIRTH_MEAN_TOLERANCE_MM)
         {
@@ -407,12 +414,13 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         }
     }
     eprintln!(
-        "{} cases; worst: limb {:.2} deg, spine bend {:.2} deg, head turn {:.2} deg, girth {:.1} mm",
+        "{} cases; worst: limb {:.2} deg, spine bend {:.2} deg, head turn {:.2} deg, girth {:.1} mm, stature {:.1} mm",
         cases.len(),
         worst[0],
         worst[1],
         worst[2],
-        worst[3]
+        worst[3],
+        worst[4]
     );
     assert!(cases.len() >= 20);
     let known = |i: usize, what: &str| KNOWN_MISSES.iter().any(|&(c, w, _)| c == i && w == what);
