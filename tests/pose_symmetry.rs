@@ -155,7 +155,8 @@ fn scan_mesh(skin: &Mesh, holes: &[usize], rng: &mut ChaCha8Rng) -> Mesh {
         *p += DVec3::new(noise.sample(rng), noise.sample(rng), noise.sample(rng));
     }
     let holes: Vec<DVec3> = holes.iter().map(|&v| skin.positions[v]).collect();
-    common::with_holes_and_cuts(Mesh::new(positions, triangles), &holes, HOLE_RADIUS_MM, CUT_MM)
+    let cuts = common::Cuts { soles_mm: CUT_MM, crown_mm: CUT_MM };
+    common::with_holes_and_cuts(Mesh::new(positions, triangles), &holes, HOLE_RADIUS_MM, cuts)
 }
 
 /// Writes `mesh` (canonical mm, Z up) as an OBJ in metres with Y up when `metres_y_up`.

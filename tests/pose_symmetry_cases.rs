@@ -8,6 +8,7 @@
 //! Then the same for a different deformer: the sim generator's capsule-limbed bodies.
 
 use crate::common;
+use common::Cuts;
 use common::frontal::{abduction, elevation};
 use dressform::body_model::BodyModel;
 use dressform::makehuman::{MakeHuman, Pose};
@@ -29,6 +30,11 @@ const PITCH_MM: f64 = 5.0;
 /// far in (a scanner sees neither).
 const HOLE_RADIUS_MM: f64 = 30.0;
 const CUT_MM: f64 = 15.0;
+/// How far the pose-symmetric scan's stature may lie outside the truth's (mm): ISO 20685-1's
+/// tolerance for stature from a scan.
+const STATURE_TOLERANCE_MM: f64 = 4.0;
+/// Where the scanner cuts every scan of this table.
+const SCANNER: Cuts = Cuts { soles_mm: CUT_MM, crown_mm: CUT_MM };
 /// Issue 15's tolerances: limb abduction and clavicle elevation, the spine's summed sideways
 /// bend, the head's turn (degrees); chest, waist and hip (mm, each and their mean).
 const LIMB_TOLERANCE_DEG: f64 = 3.0;
@@ -194,12 +200,13 @@ fn limb_angles(at: impl Fn(&str) -> DVec3, frame: DQuat) -> Vec<f64> {
 
 const LIMB_NAMES: [&str; 6] = ["arm.L", "clav.L", "leg.L", "arm.R", "clav.R", "leg.R"];
 
-/// The scan's vertices moved by noise, with holes at `holes` and the soles and crown cut.
-/// The soles end on the scanner's platform: every vertex left below `floor` + [`CUT_MM`]
+/// The scan's vertices moved by noise, with holes at `holes` and the soles and crown cut as
+/// `cuts` says.
+/// The soles end on the scanner's platform: every vertex left below `floor` + `cuts.soles_mm`
 /// (`floor` the body's lowest point before noise) is lifted onto that plane, so that the
 /// scan's floor is the platform's, not wherever the noise and the mesh's triangles put its
 /// lowest vertex (which moved the loaded scan 0-3 mm up or down, and its girths with it).
-fn scanned(mesh: &Mesh, floor: f64, holes: &[DVec3], rng: &mut ChaCha8Rng) -> Mesh {
+fn scanned(mesh: &Mesh, floor: f64, holes: &[DVec3], cuts: Cuts, rng: &mut ChaCha8Rng) -> Mesh {
     let noise = Normal::new(0.0, NOISE_MM).unwrap();
     let mut mesh = mesh.clone();
     for p in &mut mesh.positions {
@@ -211,8 +218,8 @@ fn scanned(mesh: &Mesh, floor: f64, holes: &[DVec3], rng: &mut ChaCha8Rng) -> Me
             *mesh.positions.iter().min_by(|a, c| a.distance(*h).total_cmp(&c.distance(*h))).unwrap()
         })
         .collect();
-    let platform = floor + CUT_MM;
-    common::with_holes_and_cuts(mesh, &centres, HOLE_RADIUS_MM, CUT_MM)
+    let platform = floor + cuts.soles_mm;
+    common::with_holes_and_cuts(mesh, &centres, HOLE_RADIUS_MM, cuts)
         .map_positions(|p| DVec3::new(p.x, p.y, p.z.max(platform)))
 }
 
@@ -302,7 +309,7 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         };
         let [(heads, floor), (truth_heads, truth_floor)] = [&bodies[0], &bodies[1]];
         let joint = |name: &str| heads[mh.rig.bone(name).unwrap()];
-        let scan = scanned(&remeshed("scan"), *floor, &hole_sites(&mh, heads), &mut rng);
+        let scan = scanned(&remeshed("scan"), *floor, &hole_sites(&mh, heads), SCANNER, &mut rng);
         let yaw = DQuat::from_rotation_z(case.yaw_deg.to_radians());
         let (frame_name, unit, y_up) = FRAMES[case.frame];
         let file = scan.map_positions(|p| {
@@ -338,10 +345,19 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         // noise, holes at the same places on the body, soles and crown cut) and loaded the same
         // way; both cut at its chest, waist and hip levels.
         let truth_sites = hole_sites(&mh, truth_heads);
-        let truth = scanned(&remeshed("truth"), *truth_floor, &truth_sites, &mut rng);
-        let truth_path = tmp.path().join(format!("truth_scan{i}.obj"));
-        write_obj(&truth, &truth_path);
-        let truth = load(&truth_path);
+        // The same truth with its crown kept (the same noise), for the stature below.
+        let (truth, crowned) = {
+            let scan = |cuts: Cuts, mut rng: ChaCha8Rng, name: &str| {
+                let mesh = scanned(&remeshed("truth"), *truth_floor, &truth_sites, cuts, &mut rng);
+                let path = tmp.path().join(format!("{name}{i}.obj"));
+                write_obj(&mesh, &path);
+                load(&path)
+            };
+            let kept = Cuts { crown_mm: 0.0, ..SCANNER };
+            let seed = rng.random::<u64>();
+            let rng = || ChaCha8Rng::seed_from_u64(seed);
+            (scan(SCANNER, rng(), "truth_scan"), scan(kept, rng(), "crowned_truth"))
+        };
         let at = levels(&SegmentedBody::find(&truth.body).unwrap());
         let heights = [at.chest, at.waist, at.hip];
         let girth_want = girths(&truth.body, &heights);
@@ -350,7 +366,15 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
             girth_want.iter().zip(&girth_got).map(|(a, b)| (a - b).abs()).collect();
         let girth_mean = girth_err.iter().sum::<f64>() / 3.0;
         let stature = |body: &Mesh| SegmentedBody::find(body).unwrap().landmarks().height;
-        let (stature_want, stature_got) = (stature(&truth.body), stature(&rec.reposed.posed.body));
+        // The scanner cut the crown flat, 15 mm below the top of the head as it stood; the
+        // straightening tilts that cut, and its rim's high side then lies above the truth's
+        // level cut: up to 6.4 mm on the spine-bend and non-standard cases, and within 1.3 mm
+        // of the truth on every case when neither scan loses its crown. So the stature is
+        // right when it lies between the truth's with the crown cut and with the crown kept.
+        let stature_want = [stature(&truth.body), stature(&crowned.body)];
+        let stature_got = stature(&rec.reposed.posed.body);
+        let stature_err =
+            (stature_want[0] - stature_got).max(stature_got - stature_want[1]).max(0.0);
 
         let mut row = format!(
             "case {i:2} {:?} {} {:.2} {frame_name} yaw {:+.0}: fit {:.1} s, {} it, rms {:.2}/{:.2} mm |",
@@ -376,7 +400,7 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
             }
         }
         row += &format!(
-            " | spine bend {:.1}/{bend:.1} twist {:.1}/{twist:.1} head {:.1}/{head:.1} | chest, waist, hip at {heights:.0?} (result's {:.0?}) {girth_want:.0?} off {girth_err:.1?} mm | stature {stature_want:.1}/{stature_got:.1}",
+            " | spine bend {:.1}/{bend:.1} twist {:.1}/{twist:.1} head {:.1}/{head:.1} | chest, waist, hip at {heights:.0?} (result's {:.0?}) {girth_want:.0?} off {girth_err:.1?} mm | stature {:.1}..{:.1}/{stature_got:.1}",
             case.spine_bend,
             case.spine_twist,
             case.head_turn,
@@ -384,7 +408,9 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
                 rec.result.comparison.levels.chest,
                 rec.result.comparison.levels.waist,
                 rec.result.comparison.levels.hip
-            ]
+            ],
+            stature_want[0],
+            stature_want[1],
         );
         eprintln!("{row}");
         let checks = [
@@ -398,11 +424,12 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
             }
         }
         worst[3] = worst[3].max(girth_err.iter().copied().fold(0.0, f64::max));
-        // The stature is printed, not checked: with the trunk straightened, the pose-symmetric
-        // scan reads 3.5-6.4 mm taller than the truth (the spine-bend and non-standard cases;
-        // within 1.4 elsewhere), beyond ISO 20685-1's 4 mm. Not explained yet: one suspect is
-        // the crown the scanner cut flat, tilted by the straightening.
-        worst[4] = worst[4].max((stature_got - stature_want).abs());
+        worst[4] = worst[4].max(stature_err);
+        if stature_err > STATURE_TOLERANCE_MM {
+            let [cut, kept] = stature_want;
+            let range = format!("{cut:.1} (crown cut) to {kept:.1} (crown kept)");
+            misses.push((i, "stature".into(), format!("{stature_got:.1} outside {range}")));
+        }
         if girth_err.iter().any(|&e| exceeds(e, GIRTH_TOLERANCE_MM))
             || exceeds(girth_mean, GIRTH_MEAN_TOLERANCE_MM)
         {

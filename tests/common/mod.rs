@@ -208,14 +208,22 @@ pub fn uniform(seed: u64, k: u64, lo: f64, hi: f64) -> f64 {
     lo + (hi - lo) * (z >> 11) as f64 / (1u64 << 53) as f64
 }
 
-/// `mesh` as a scanner leaves it: the triangles within `cut_mm` of its lowest and highest
-/// point (the soles, the crown) removed, and those within `radius_mm` of each of `holes`.
-pub fn with_holes_and_cuts(mut mesh: Mesh, holes: &[DVec3], radius_mm: f64, cut_mm: f64) -> Mesh {
+/// How far in a scanner cuts a body: the soles (on its platform) and the crown (which it
+/// does not see), in mm from the body's lowest and highest point.
+#[derive(Clone, Copy)]
+pub struct Cuts {
+    pub soles_mm: f64,
+    pub crown_mm: f64,
+}
+
+/// `mesh` as a scanner leaves it: the triangles within `cuts` of its lowest and highest point
+/// (the soles, the crown) removed, and those within `radius_mm` of each of `holes`.
+pub fn with_holes_and_cuts(mut mesh: Mesh, holes: &[DVec3], radius_mm: f64, cuts: Cuts) -> Mesh {
     let b = mesh.bounds().expect("a scan has vertices");
     let keep: Vec<bool> = (0..mesh.triangles.len())
         .map(|t| {
             let c = mesh.corners(t).iter().sum::<DVec3>() / 3.0;
-            let cut = c.z < b.min.z + cut_mm || c.z > b.max.z - cut_mm;
+            let cut = c.z < b.min.z + cuts.soles_mm || c.z > b.max.z - cuts.crown_mm;
             !cut && holes.iter().all(|h| h.distance(c) >= radius_mm)
         })
         .collect();
