@@ -273,12 +273,11 @@ fn thigh_creases(mesh: &Mesh, axis: f64, crotch: f64) -> (f64, f64) {
 /// The crease along the legs' top ring that one edge in ten may exceed (degrees). Where the
 /// thighs met the hips keeping their own slope, the back of that ring creased 6-15 degrees (a
 /// light line across the thighs at the crotch in a shaded picture); its 90th percentile was
-/// 4.4 on the asymmetric example, 8.7 on the demo's customer, 11.1 on the MakeHuman base and
-/// 12.0 on the posed MakeHuman body. With the thighs leaving the hips at the hips' slope: 2.3-4.1
-/// on the generator's 20 random bodies, 3.8, 5.2-5.3 (both demo bodies), 9.8 and 10.8. The
-/// limit sits between the posed MakeHuman body's two values: no margin (what is left on the
-/// MakeHuman bodies is not explained yet).
-const JOIN_TICKS_DEG: f64 = 11.5;
+/// 4.5 on the asymmetric example, 8.7 on the demo's customer (both ways), 11.1 on the
+/// MakeHuman base and 12.0 on the posed MakeHuman body. With the thighs leaving the hips at the
+/// hips' slope: 1.4-3.3 on the generator's 20 random bodies, 3.1, 2.9-3.0, 8.3 and 9.0. What is
+/// left on the MakeHuman bodies is not explained yet.
+const JOIN_TICKS_DEG: f64 = 10.0;
 
 /// The share of the legs' top ring's edges [`JOIN_TICKS_DEG`] is read at.
 const JOIN_TICKS_SHARE: f64 = 0.9;
