@@ -226,7 +226,8 @@ const SECTOR_EDGES: usize = 5;
 /// on the generator's bodies (the gluteal fold's turn on single rings: a shaded line across
 /// the back of the thighs) and 7.8 on the demo's reconstructed customer; with the mesh's finer
 /// rings there, 4.0-6.0 and 4.8, and 5.0-7.4 on the MakeHuman bodies, where the body's own
-/// coarse facets show.
+/// coarse facets show; with the thighs also leaving the hips at the hips' slope, 4.0-6.7,
+/// 5.0-5.1 and 6.1-7.3.
 const THIGH_CREASE_DEG: f64 = 8.0;
 
 /// The sharpest ring of the left thigh between `top` and `bottom` mm below the crotch: the
