@@ -181,12 +181,9 @@ pub fn build(
     thighs::ease(&torso[0], &torso[1], &mut left_leg, &mut right_leg);
     let own = symmetric_landmarks(&landmarks, axis);
     let plates = [&own.left_armhole, &own.right_armhole];
-    let rings: Vec<TorsoRing> = torso
-        .iter()
-        .take_while(|layer| layer.z < cap.from)
-        .map(|layer| arm_plates::rim(layer, axis, plates, options.preserve))
-        .chain(cap.rings.iter().map(|ring| TorsoRing::from_rays(ring)))
-        .collect();
+    let below_cap = torso.iter().take_while(|layer| layer.z < cap.from).count();
+    let mut rings = arm_plates::rims(&torso[..below_cap], axis, plates, options.preserve);
+    rings.extend(cap.rings.iter().map(|ring| TorsoRing::from_rays(ring)));
     let mesh =
         rebuild::rebuild(&rings, cap.neck_centre, &left_leg, &right_leg, axis, landmarks.crotch);
     // The legs' layers without the mesh's rings between them.

@@ -294,12 +294,30 @@ pub fn edge_creases(
 /// A vertex lies on a plate within this distance of its plane (mm).
 const ON_PLATE_MM: f64 = 1e-3;
 
-/// The total turning (degrees) of the rim of the flat region of `mesh` in the plane through
-/// `point` with unit normal `normal`: the longest boundary loop of the faces whose corners all
-/// lie within [`ON_PLATE_MM`] of the plane, with the loop's vertex count (`None` where no face
-/// lies on it). A convex curve turns 360 degrees in all; each step of a staircase adds about
-/// 180.
-pub fn plate_rim_turning(mesh: &Mesh, point: DVec3, normal: DVec3) -> Option<(f64, usize)> {
+/// The rim of a flat arm plate: the longest boundary loop of the faces of a mesh lying in
+/// one plane (see [`plate_rim`]).
+#[derive(Debug, Clone, Copy)]
+pub struct PlateRim {
+    /// The rim's total turning (degrees): a convex curve turns 360 in all; each step of a
+    /// staircase adds about 180.
+    pub turning_deg: f64,
+    /// The rim's vertex count.
+    pub vertices: usize,
+    /// The length of the rim's flat bottom (mm): its edges that lie level with its lowest
+    /// vertex (within [`LEVEL_MM`]). A plate's rim is round at the bottom, but where the first
+    /// ring to meet the plate does so with a long chord over a ring that does not reach it, the
+    /// rim has a flat bottom that long over a tab leaning into the torso.
+    pub flat_bottom_mm: f64,
+}
+
+/// Two rim vertices are level within this height difference (mm): the rings' heights are
+/// written at 0.001 mm.
+const LEVEL_MM: f64 = 0.01;
+
+/// The rim of the flat region of `mesh` in the plane through `point` with unit normal
+/// `normal`: the longest boundary loop of the faces whose corners all lie within
+/// [`ON_PLATE_MM`] of the plane (`None` where no face lies on it).
+pub fn plate_rim(mesh: &Mesh, point: DVec3, normal: DVec3) -> Option<PlateRim> {
     let on = |v: u32| (mesh.positions[v as usize] - point).dot(normal).abs() <= ON_PLATE_MM;
     let mut uses: HashMap<(u32, u32), usize> = HashMap::new();
     for tri in mesh.triangles.iter().filter(|tri| tri.iter().all(|&v| on(v))) {
@@ -348,5 +366,12 @@ pub fn plate_rim_turning(mesh: &Mesh, point: DVec3, normal: DVec3) -> Option<(f6
             a.perp_dot(b).atan2(a.dot(b)).abs()
         })
         .sum();
-    Some((turning.to_degrees(), n))
+    let at = |k: usize| mesh.positions[longest[k % n] as usize];
+    let lowest = (0..n).map(|k| at(k).z).fold(f64::INFINITY, f64::min);
+    let level = |p: DVec3| p.z - lowest <= LEVEL_MM;
+    let flat_bottom_mm = (0..n)
+        .filter(|&k| level(at(k)) && level(at(k + 1)))
+        .map(|k| at(k).distance(at(k + 1)))
+        .sum();
+    Some(PlateRim { turning_deg: turning.to_degrees(), vertices: n, flat_bottom_mm })
 }
