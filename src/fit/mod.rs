@@ -6,8 +6,8 @@
 //! ([`correspondences`]), point-to-plane plus a little point-to-point, pairs rejected where the
 //! normals disagree or the scan point lies on a hole's boundary, Geman-McClure weights
 //! ([`robust`]) annealed coarse to fine; eq. 4's regularisers ([`priors`]): a prior on beta,
-//! joint limits ([`joint_limits`]), a smoothness prior along the spine, a weak pull of the
-//! angles to rest (not the upper arms' abduction). Coarse to fine in the unknowns as well
+//! joint limits ([`joint_limits`]), a smoothness prior along the spine (and on to the neck's
+//! sideways bend), a weak pull of the angles to rest (not the upper arms' abduction). Coarse to fine in the unknowns as well
 //! ([`STAGES`]): global placement and shape, then spine, shoulders, arms, elbows and hips,
 //! then every bone. Before the limbs are freed the arms try several abductions ([`arm_starts`]) against
 //! the local minimum of an arm matched to the torso.
