@@ -395,27 +395,8 @@ mod tests {
     fn the_corners_come_back_on_the_plates_with_the_girth_kept() {
         // An ellipse 260 x 180 mm cut by two upright plates at x = +-100 mm, made symmetric by
         // rays: the corners where the plates meet the ellipse lie at y = +-90 sqrt(1 - (100/130)^2).
-        let ellipse = Contour {
-            points: (0..2000)
-                .map(|k| {
-                    let t = TAU * k as f64 / 2000.0;
-                    DVec2::new(130.0 * t.cos(), 90.0 * t.sin())
-                })
-                .collect(),
-        };
-        let section = ellipse.clip_x(-100.0, 100.0);
-        let ring = axial::symmetrize(&section, 0.0, 360, Preserve::Tape).unwrap();
-        let girth = Contour { points: ring.points.clone() }.tape_girth();
-        let layer = Layer {
-            region: Region::Torso,
-            z: 50.0,
-            centre: ring.centre.to_array(),
-            points: ring.points,
-            input_tape_girth: girth,
-            input_contour_length: girth,
-            tape_girth: girth,
-            contour_length: girth,
-        };
+        let layer = cut_ellipse(130.0, 90.0, 50.0);
+        let girth = layer.tape_girth;
         let plate = |x: f64, side: f64| {
             Armhole::through(DVec3::new(x, 0.0, 0.0), DVec3::new(x, 0.0, 100.0), DVec3::NEG_Y, side)
         };
