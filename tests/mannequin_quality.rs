@@ -144,8 +144,8 @@ const SHOULDER_LINE_MM: f64 = 5.0;
 const LEG_STANCE_DEG: f64 = 0.5;
 /// The most the left arm plate's rim may turn in all (degrees): a convex curve turns 360, and
 /// each step of a staircase (one per layer, 15-20 layers up each side) adds about 180; the
-/// rims, one curve, turn 360-422 degrees on the generator's bodies and 534 on the demo's
-/// noisy scan.
+/// rims, one curve, turn 360-454 degrees on the generator's bodies, 384 on the asymmetric
+/// example, 421 on MakeHuman and 467 on the demo's noisy scan.
 const RIM_TURNING_DEG: f64 = 560.0;
 /// The longest flat bottom the left arm plate's rim may have (mm; see [`PlateRim`]). Before
 /// the rim's lower edge was drawn round it was the first ring's whole chord on the plate:

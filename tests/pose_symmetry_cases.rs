@@ -430,7 +430,7 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         }
     }
     eprintln!(
-        "{} cases; worst: limb {:.2} deg, spine bend {:.2} deg, head turn {:.2} deg, girth {:.1} mm, stature {:.1} mm",
+        "{} cases; worst: limb {:.2} deg, spine bend {:.2} deg, head turn {:.2} deg, girth {:.1} mm, stature {:.1} mm outside its range",
         cases.len(),
         worst[0],
         worst[1],

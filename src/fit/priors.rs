@@ -61,7 +61,7 @@ const SPINE: [&str; 4] = ["spine04", "spine03", "spine02", "spine01"];
 /// at -1.7 (with it: 10.0; the other bent cases' error 0.3-1.1 -> 0.0-0.4). The forward bend
 /// (X) and the turn (Z) stay free: a forward head and the head's turn are the neck's own, and a
 /// smoothed turn would pull the spine's twist after the head.
-pub const NECK_SMOOTHNESS: [f64; 3] = [0.0, 1.0, 0.0];
+const NECK_SMOOTHNESS: [f64; 3] = [0.0, 1.0, 0.0];
 
 /// The pose regularisers of one skeleton.
 pub struct Priors {

@@ -97,6 +97,9 @@ fn slope_change(
     axis: f64,
 ) -> Vec<DVec2> {
     let depth = top.z - below.z;
+    if depth <= 0.0 {
+        return vec![DVec2::ZERO; top.points.len()];
+    }
     let n = slope.len();
     top.points
         .iter()
