@@ -25,8 +25,8 @@
 //! kept only where the rim is at most [`Bottom::half_width`] from its middle, and the ring's
 //! side beyond is drawn back off the plate ([`narrow`]).
 
-use super::Layer;
 use super::rebuild::TorsoRing;
+use super::{Layer, smoothstep};
 use crate::regions::Armhole;
 use crate::slice::Contour;
 use crate::symmetry::Preserve;
@@ -197,12 +197,6 @@ fn narrow(
         }
     }
     *points = out;
-}
-
-/// The smooth step from 0 (at `s` <= 0) to 1 (at `s` >= 1), with zero slope at both ends.
-fn smoothstep(s: f64) -> f64 {
-    let s = s.clamp(0.0, 1.0);
-    s * s * (3.0 - 2.0 * s)
 }
 
 /// From this fraction of a ring's half-width out, the girth its drawn-back sides lost is given

@@ -105,6 +105,13 @@ impl Mannequin {
     }
 }
 
+/// The smooth step from 0 (at `s` <= 0) to 1 (at `s` >= 1), with zero slope at both ends:
+/// how the rebuild's easings (arm plates, shoulder cap, thighs) fade in and out.
+fn smoothstep(s: f64) -> f64 {
+    let s = s.clamp(0.0, 1.0);
+    s * s * (3.0 - 2.0 * s)
+}
+
 /// The landmarks `m` made symmetric about the plane x = `axis` (see
 /// [`Mannequin::own_landmarks`]).
 fn symmetric_landmarks(m: &Landmarks, axis: f64) -> Landmarks {

@@ -27,7 +27,7 @@
 //! profiles the robotic form copies) stay horizontal with their sections' girths; only the
 //! mesh uses the bent rings.
 
-use super::{Layer, MannequinError, MannequinOptions};
+use super::{Layer, MannequinError, MannequinOptions, smoothstep};
 use crate::mesh::Mesh;
 use crate::regions::{Landmarks, Region};
 use crate::slice::{Contour, sections};
@@ -84,12 +84,6 @@ impl Bend {
     fn lift(&self, p: DVec2) -> DVec3 {
         p.extend(self.t + self.rise(p.x))
     }
-}
-
-/// The smooth step from 0 (at `s` <= 0) to 1 (at `s` >= 1), with zero slope at both ends.
-fn smoothstep(s: f64) -> f64 {
-    let s = s.clamp(0.0, 1.0);
-    s * s * (3.0 - 2.0 * s)
 }
 
 /// Half the width of a ring about the plane x = `axis`.

@@ -16,8 +16,8 @@
 //! turning back to the thigh's own over the same height ([`ease_leg`]). Each eased layer reports
 //! the girth of its new shape; the torso is not changed.
 
-use super::Layer;
 use super::rebuild::closest_on_ring;
+use super::{Layer, smoothstep};
 use crate::slice::Contour;
 use glam::DVec2;
 
@@ -47,12 +47,6 @@ const MAX_TURN: f64 = 0.58;
 /// slope at its top, all of it at the plane: the inner thighs meet there in the crotch's
 /// saddle, which the hips above it do not continue.
 const BESIDE_PLANE_MM: f64 = 30.0;
-
-/// The smooth step from 0 (at `t` <= 0) to 1 (at `t` >= 1), with zero slope at both ends.
-fn smoothstep(t: f64) -> f64 {
-    let t = t.clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
 
 /// Where each point of the top leg ring `top` must move to meet `surface`, the hips above it
 /// continued down to it (symmetric about the plane x = `axis`): where it lies outside, all the
