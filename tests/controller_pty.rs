@@ -83,6 +83,43 @@ fn drives_the_form_over_slcan_on_a_pty() {
     drive_over(&runtime, &server, slcan);
 }
 
+/// A host that opened the channel, asked every node to identify and went away without
+/// reading leaves 16 answers in the pty; the next host does not take them for its own (it
+/// clears its input on opening, as pyserial does; the simulated adapter no longer takes back
+/// bytes it wrote, which raced hosts that were reading).
+#[test]
+fn a_host_that_went_away_leaves_no_answers_for_the_next() {
+    use std::io::Write;
+    let (runtime, server) = start(Served::SlcanPty);
+    let mut gone = serialport::new(server.device_path().to_string_lossy(), 115_200)
+        .timeout(Duration::from_millis(10))
+        .open()
+        .unwrap();
+    // IdentifyRequest (code 14) broadcast: id 14 << 6, no data.
+    gone.write_all(b"S8\rO\rt3800\r").unwrap();
+    // 8 Identity (6 bytes) and 8 Capabilities lines, at least `tIIIL` and `\r` each.
+    let answers = 16 * 6;
+    let deadline = std::time::Instant::now() + Duration::from_secs(10);
+    while gone.bytes_to_read().unwrap() < answers {
+        assert!(std::time::Instant::now() < deadline, "the nodes did not answer");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    drop(gone);
+
+    let mut next = Slcan::open(server.device_path()).unwrap();
+    let heard = runtime.block_on(async {
+        let mut heard = Vec::new();
+        let listen = async {
+            loop {
+                heard.push(next.recv().await.unwrap().message.code());
+            }
+        };
+        let _ = tokio::time::timeout(Duration::from_millis(300), listen).await;
+        heard
+    });
+    assert!(!heard.contains(&firmware_protocol::Code::Identity), "{heard:?}");
+}
+
 /// Behind a slow adapter (every frame 20 ms late each way, as behind a USB-serial adapter's
 /// latency timer) one poll of the 8 nodes takes over 300 ms (the CAN loss limit); nodes that
 /// answer every poll are not lost for it, and the move completes.

@@ -14,7 +14,8 @@
 //! a host that reads late, or a kernel that holds the pty's bytes for a while (below), loses
 //! nothing. Only a queue past [`OUTBOX_LIMIT`] — a reader dead for seconds — loses its
 //! oldest whole messages, as a real adapter's buffer overflows; a new session starts with an
-//! empty queue ([`Pty::discard_unread`]).
+//! empty queue ([`Pty::discard_unread`]), and bytes already written stay for the host to
+//! read or clear.
 //!
 //! **The kernel's own stalls.** A pty is not a wire: bytes written to one side reach the other
 //! through the kernel's tty flip buffers, pushed by a shared kernel worker. On a loaded machine
@@ -187,11 +188,16 @@ impl Pty {
         let _ = rustix::termios::ioctl_tiocnxcl(&self.slave);
     }
 
-    /// Drops what was written or queued for the host but not read yet (stale answers of a
-    /// host that went away).
+    /// Drops what is queued for the host and not yet written (stale answers of a host that
+    /// went away), as a real adapter empties its own buffer.
+    ///
+    /// What the kernel already holds stays: a real adapter cannot take back bytes it sent, and
+    /// flushing the terminal's input under a host that is reading races it. pyserial (and so
+    /// python-can) reads with `VMIN = 0` after `select`, so bytes flushed between the two make
+    /// the read return nothing, which it reports as a disconnected device. Hosts clear their
+    /// input when they open the port (pyserial's `open` does; so does dressform's).
     pub fn discard_unread(&self) {
         self.outbox().clear();
-        let _ = rustix::termios::tcflush(&self.slave, rustix::termios::QueueSelector::IFlush);
     }
 }
 
@@ -252,6 +258,30 @@ mod tests {
         outbox.advance(message.len() - 3);
         assert_eq!(outbox.next().len(), message.len());
         assert_eq!(outbox.messages.len(), 3);
+    }
+
+    /// A new session drops what is still queued but never what the kernel holds: taking
+    /// bytes back under a reading host makes pyserial's read return nothing (see
+    /// [`Pty::discard_unread`]).
+    #[tokio::test]
+    async fn a_new_session_drops_the_queue_and_leaves_the_written_bytes() {
+        let pty = Pty::open().unwrap();
+        let mut host = std::fs::OpenOptions::new().read(true).open(pty.path()).unwrap();
+        pty.queue(b"written\r");
+        pty.flush().await.unwrap();
+        pty.queue(b"queued\r");
+        pty.discard_unread();
+        assert!(!pty.has_unsent());
+        pty.queue(b"new\r");
+        pty.flush().await.unwrap();
+        // On a thread, so that a lost byte fails the test rather than hanging it.
+        let (sender, received) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let mut got = [0u8; 12];
+            let _ = sender.send(host.read_exact(&mut got).map(|()| got));
+        });
+        let got = received.recv_timeout(std::time::Duration::from_secs(10));
+        assert_eq!(got.expect("bytes were lost").unwrap(), *b"written\rnew\r");
     }
 
     /// A host that does not read for longer than the kernel buffers (about 20 KB on Linux)

@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use firmware_protocol::Packet;
-use serialport::SerialPort;
+use serialport::{ClearBuffer, SerialPort};
 use tokio::sync::mpsc;
 
 use super::TransportError;
@@ -51,6 +51,9 @@ impl Line {
             .timeout(READ_TIMEOUT)
             .open()
             .map_err(|e| io(std::io::Error::from(e)))?;
+        // What the device sent before this session (a host that went away left it unread)
+        // is not an answer to this one: drop it, as pyserial's `open` does.
+        writer.clear(ClearBuffer::Input).map_err(|e| io(std::io::Error::from(e)))?;
         let mut reader = writer.try_clone().map_err(|e| io(std::io::Error::from(e)))?;
         let (tx, packets) = mpsc::unbounded_channel();
         let stop = Arc::new(AtomicBool::new(false));
