@@ -15,6 +15,7 @@
 //! bounding-box centres.
 
 mod arm_plates;
+mod fairing;
 mod layers;
 mod rebuild;
 mod shoulder_cap;
@@ -181,13 +182,17 @@ pub fn build(
         });
     }
     crate::symmetry::check_rays(options.rays)?;
-    let layers::SymmetricLayers { axis, torso, mut left_leg, mut right_leg, is_layer } =
+    let layers::SymmetricLayers { axis, mut torso, mut left_leg, mut right_leg, is_layer } =
         layers::symmetric_layers(body, keep, options)?;
     let landmarks = *body.landmarks();
-    let cap = shoulder_cap::build(body.mesh(), &landmarks, &torso, axis, options)?;
-    thighs::ease(&torso[0], &torso[1], &mut left_leg, &mut right_leg);
     let own = symmetric_landmarks(&landmarks, axis);
     let plates = [&own.left_armhole, &own.right_armhole];
+    fairing::fair(&mut torso, &plates, options.preserve, true);
+    for leg in [&mut left_leg, &mut right_leg] {
+        fairing::fair(leg, &[], options.preserve, false);
+    }
+    let cap = shoulder_cap::build(body.mesh(), &landmarks, &torso, axis, options)?;
+    thighs::ease(&torso[0], &torso[1], &mut left_leg, &mut right_leg);
     let below_cap = torso.iter().take_while(|layer| layer.z < cap.from).count();
     let mut rings = arm_plates::rims(&torso[..below_cap], axis, plates, options.preserve);
     rings.extend(cap.rings.iter().map(|ring| TorsoRing::from_rays(ring)));
