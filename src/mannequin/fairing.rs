@@ -82,15 +82,13 @@ pub(super) fn fair(layers: &mut [Layer], plates: &[&Armhole], preserve: Preserve
             // Every layer's point on ray i, seen from the new centre along the ray: the
             // centres (the sections' box centres, eq. 5) jitter too, by 0.4 mm front to back.
             let u = (*p - centres[k]).normalize_or_zero();
-            let (sum, weight) = near
+            let samples = near
                 .iter()
                 .filter(|&&(j, _)| !on_plate[j][i])
-                .fold((0.0, 0.0), |(s, t), &(j, w)| {
-                    (s + w * (radii[j][i] + (centres[j] - c).dot(u)), t + w)
-                });
+                .map(|&(j, w)| (heights[j] - heights[k], radii[j][i] + (centres[j] - c).dot(u), w));
             // Seen from the new centre, the point itself lies at `own` along the ray.
             let own = radii[k][i] + (centres[k] - c).dot(u);
-            let faired = own + (sum / weight - own).clamp(-MAX_MOVE_MM, MAX_MOVE_MM);
+            let faired = own + (local_line(samples) - own).clamp(-MAX_MOVE_MM, MAX_MOVE_MM);
             *p = c + u * faired;
         }
         if torso {
@@ -110,6 +108,28 @@ pub(super) fn fair(layers: &mut [Layer], plates: &[&Armhole], preserve: Preserve
         layer.points = ring.points;
     }
 }
+
+/// The value at 0 of the line fitted by weighted least squares to `(x, y, weight)` samples:
+/// the weighted mean where the samples lie evenly on both sides, and no pull towards the
+/// inside at the first and last layers, where they lie on one side only (a plain mean there
+/// drew the legs' top rings in by the thighs' slope, a crease at the crotch). The mean where
+/// the samples do not determine a line.
+fn local_line(samples: impl Iterator<Item = (f64, f64, f64)>) -> f64 {
+    let [mut w, mut x, mut y, mut xx, mut xy] = [0.0; 5];
+    for (xi, yi, wi) in samples {
+        w += wi;
+        x += wi * xi;
+        y += wi * yi;
+        xx += wi * xi * xi;
+        xy += wi * xi * yi;
+    }
+    let det = w * xx - x * x;
+    if det > DEGENERATE * w * xx { (xx * y - x * xy) / det } else { y / w }
+}
+
+/// A line fit is degenerate when its determinant is below this share of `w * xx`: the
+/// samples all at one height (a single layer).
+const DEGENERATE: f64 = 1e-9;
 
 /// Whether `p` at height `z` is on `plate` (see [`PLATE_BAND_MM`]).
 fn on(plate: &Armhole, p: DVec2, z: f64) -> bool {

@@ -2,7 +2,8 @@
 //! ([`crate::symmetry`]), and the layers rebuilt into one watertight mesh ([`rebuild`]).
 //!
 //! Layers (defaults from the paper): 100 torso layers from just above the crotch to the neck,
-//! 50 leg layers from the ankles to just below the crotch. Above the armpits the torso sections
+//! 50 leg layers from the ankles to just below the crotch, faired across heights against the
+//! scanner's leftover noise, girths kept ([`fairing`]). Above the armpits the torso sections
 //! are cut at the armholes ([`crate::regions::Armhole`]), so the arms are not part of the
 //! torso: the cut edges stack into flat arm plates, each rimmed by one smooth curve
 //! ([`arm_plates`]). Every torso layer is horizontal and keeps
