@@ -13,7 +13,8 @@
 //! layer is then made mirror-symmetric again (eq. 7) and scaled back to the girth it had
 //! (eq. 8 and 12), so every girth is kept exactly. Points on the arm plates (at or beyond a
 //! plate, less [`PLATE_BAND_MM`], between the armpit and the shoulder point) are neither moved
-//! nor used: the plates are cut flat ([`super::arm_plates`]), not averaged.
+//! nor used: the plates are cut flat ([`super::arm_plates`]), not averaged. The shoulder cap's
+//! bent rings ([`super::shoulder_cap`]) are faired the same way where they are level.
 
 use super::Layer;
 use crate::regions::Armhole;
@@ -44,10 +45,16 @@ const MAX_MOVE_MM: f64 = 1.0;
 const PLATE_BAND_MM: f64 = 2.0;
 
 /// Fairs `layers` (bottom to top, one region, each with the same number of rays) in place
-/// (see the module docs); `plates` are the mannequin's own arm plates (none for the legs).
-/// `torso`: the rings are torso rings, mirror images of themselves (eq. 7 is applied again);
-/// the legs' rings are mirrored by the other leg's, faired alike.
-pub(super) fn fair(layers: &mut [Layer], plates: &[&Armhole], preserve: Preserve, torso: bool) {
+/// (see the module docs); `fixed(k, p)`: point `p` of layer `k` is neither moved nor used
+/// (on an arm plate, [`on_plates`]). `torso`: the rings are torso rings, mirror images of
+/// themselves (eq. 7 is applied again); the legs' rings are mirrored by the other leg's,
+/// faired alike.
+pub(super) fn fair(
+    layers: &mut [Layer],
+    fixed: &dyn Fn(usize, DVec2) -> bool,
+    preserve: Preserve,
+    torso: bool,
+) {
     let Some(rays) = layers.first().map(|l| l.points.len()) else { return };
     if layers.iter().any(|l| l.points.len() != rays) {
         return;
@@ -59,7 +66,8 @@ pub(super) fn fair(layers: &mut [Layer], plates: &[&Armhole], preserve: Preserve
         .collect();
     let on_plate: Vec<Vec<bool>> = layers
         .iter()
-        .map(|l| l.points.iter().map(|p| plates.iter().any(|a| on(a, *p, l.z))).collect())
+        .enumerate()
+        .map(|(k, l)| l.points.iter().map(|&p| fixed(k, p)).collect())
         .collect();
     let heights: Vec<f64> = layers.iter().map(|l| l.z).collect();
     let reach = REACH_SIGMAS * SIGMA_MM;
@@ -131,6 +139,11 @@ fn local_line(samples: impl Iterator<Item = (f64, f64, f64)>) -> f64 {
 /// samples all at one height (a single layer).
 const DEGENERATE: f64 = 1e-9;
 
+/// Whether `p` at height `z` is on one of `plates` (see [`PLATE_BAND_MM`]).
+pub(super) fn on_plates(plates: &[&Armhole], p: DVec2, z: f64) -> bool {
+    plates.iter().any(|plate| on(plate, p, z))
+}
+
 /// Whether `p` at height `z` is on `plate` (see [`PLATE_BAND_MM`]).
 fn on(plate: &Armhole, p: DVec2, z: f64) -> bool {
     let within = z >= plate.armpit.z && z <= plate.shoulder_point.z;
@@ -196,7 +209,7 @@ mod tests {
         let noisy = rings(30, 0.4, |z, i| 150.0 + 0.3 * noise(i * 31 + z as usize));
         for preserve in Preserve::ALL {
             let mut faired = noisy.clone();
-            fair(&mut faired, &[], preserve, true);
+            fair(&mut faired, &|_, _| false, preserve, true);
             let (before, after) = (roughness(&noisy), roughness(&faired));
             assert!(after < 0.6 * before, "{preserve:?}: {before:.3} -> {after:.3} mm");
             for (layer, was) in faired.iter().zip(&noisy) {
@@ -223,7 +236,7 @@ mod tests {
         };
         let body = rings(30, 0.0, groove);
         let mut faired = body.clone();
-        fair(&mut faired, &[], Preserve::Tape, true);
+        fair(&mut faired, &|_, _| false, Preserve::Tape, true);
         let moved = faired
             .iter()
             .zip(&body)
@@ -263,7 +276,9 @@ mod tests {
             }
         }
         let mut faired = cut.clone();
-        fair(&mut faired, &[&plate, &mirrored], Preserve::Tape, true);
+        let heights: Vec<f64> = cut.iter().map(|l| l.z).collect();
+        let plates = [&plate, &mirrored];
+        fair(&mut faired, &|k, p| on_plates(&plates, p, heights[k]), Preserve::Tape, true);
         for (layer, was) in faired.iter().zip(&cut) {
             for (p, q) in layer.points.iter().zip(&was.points) {
                 let on = [&plate, &mirrored].iter().any(|a| on(a, *q, layer.z));

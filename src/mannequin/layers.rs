@@ -49,7 +49,14 @@ fn spaced(lo: f64, hi: f64, count: usize) -> Vec<f64> {
     (0..count).map(|k| lo + (hi - lo) * k as f64 / (count - 1) as f64).collect()
 }
 
-fn layer(region: Region, z: f64, centre: DVec2, points: Vec<DVec2>, input: &Contour) -> Layer {
+/// A layer of `points` about `centre` at height `z`, made from the section `input`.
+pub(super) fn layer(
+    region: Region,
+    z: f64,
+    centre: DVec2,
+    points: Vec<DVec2>,
+    input: &Contour,
+) -> Layer {
     let ring = Contour { points };
     Layer {
         region,

@@ -188,9 +188,11 @@ pub fn build(
     let landmarks = *body.landmarks();
     let own = symmetric_landmarks(&landmarks, axis);
     let plates = [&own.left_armhole, &own.right_armhole];
-    fairing::fair(&mut torso, &plates, options.preserve, true);
+    let heights: Vec<f64> = torso.iter().map(|layer| layer.z).collect();
+    let on_plates = |k: usize, p| fairing::on_plates(&plates, p, heights[k]);
+    fairing::fair(&mut torso, &on_plates, options.preserve, true);
     for leg in [&mut left_leg, &mut right_leg] {
-        fairing::fair(leg, &[], options.preserve, false);
+        fairing::fair(leg, &|_, _| false, options.preserve, false);
     }
     let cap = shoulder_cap::build(body.mesh(), &landmarks, &torso, axis, options)?;
     thighs::ease(&torso[0], &torso[1], &mut left_leg, &mut right_leg);

@@ -27,7 +27,7 @@
 //! profiles the robotic form copies) stay horizontal with their sections' girths; only the
 //! mesh uses the bent rings.
 
-use super::{Layer, MannequinError, MannequinOptions, smoothstep};
+use super::{Layer, MannequinError, MannequinOptions, fairing, smoothstep};
 use crate::mesh::Mesh;
 use crate::regions::{Landmarks, Region};
 use crate::slice::{Contour, sections};
@@ -49,6 +49,10 @@ const RAMP_MM: f64 = 30.0;
 /// a layer (7.3 mm) apart sagged 5.1 mm under the body's silhouette; half as far apart, it
 /// sags a quarter as much.
 const RINGS_PER_LAYER: usize = 2;
+
+/// Only points this far inside the wing (mm) are faired ([`super::fairing`]): a ring's point
+/// near the wing may lie beyond it on the next ring.
+const LEVEL_MARGIN_MM: f64 = 10.0;
 
 /// Heights closer than this are one (mm): a torso layer at the lower shoulder point itself.
 const SAME_HEIGHT_MM: f64 = 1e-6;
@@ -165,15 +169,27 @@ pub(super) fn build(
     let groups: Vec<&[(Bend, DVec2)]> = bends.chunk_by(|a, b| a.0.slope == b.0.slope).collect();
     let sections: Vec<Option<Contour>> =
         groups.par_iter().flat_map_iter(|group| bent_sections(&part, group, lm)).collect();
-    let rings = bends
+    let mut flat = bends
         .iter()
         .zip(sections)
         .map(|(&(bend, _), c)| {
             let missing = MannequinError::MissingLoop { region: Region::Torso, z: bend.t };
-            let ring = axial::symmetrize(&c.ok_or(missing)?, axis, o.rays, o.preserve)?;
-            Ok(ring.points.iter().map(|&p| bend.lift(p)).collect())
+            let c = c.ok_or(missing)?;
+            let ring = axial::symmetrize(&c, axis, o.rays, o.preserve)?;
+            Ok(super::layers::layer(Region::Torso, bend.t, ring.centre, ring.points, &c))
         })
-        .collect::<Result<Vec<Vec<DVec3>>, MannequinError>>()?;
+        .collect::<Result<Vec<Layer>, MannequinError>>()?;
+    // Faired as the torso layers are where the rings are level (over the neck and the inner
+    // shoulders); beyond the wing they cross the shoulder top steeply, one ray's points on
+    // neighbouring rings lie on different parts of the shoulder, and averaging them widened
+    // the shoulder's width jump by 8-11 mm.
+    let level = |p: DVec2| (p.x - axis).abs() < wing - LEVEL_MARGIN_MM;
+    fairing::fair(&mut flat, &|_, p| !level(p), o.preserve, true);
+    let rings = flat
+        .iter()
+        .zip(&bends)
+        .map(|(ring, (bend, _))| ring.points.iter().map(|&p| bend.lift(p)).collect())
+        .collect();
     let neck_centre = DVec3::new(axis, neck.centre[1], neck.z);
     Ok(ShoulderCap { from, rings, neck_centre })
 }
