@@ -2,19 +2,20 @@
 //!
 //! Each layer is sampled from its own section, so what is left of the scanner's noise after
 //! denoising ([`crate::mesh::Mesh::taubin_smooth`]) differs from one layer to the next: on the
-//! demo customer's scan a ray's radius jumps by 0.6 mm RMS (second difference) from layer to
+//! demo customer's scan a ray's point jumped 0.63 mm RMS (second difference) from layer to
 //! layer mid-torso, where the body's own curvature accounts for about 0.1 mm. Between two
-//! rings the mesh is flat, so every layer showed as a shaded horizontal band, and the two
-//! layers between the demo's unequal armpits (one side already cut at its armhole, the other
-//! not) stood out as a tab under the arm plates.
+//! rings the mesh is flat, so the surface looked lumpy and every layer showed as a shaded
+//! horizontal band.
 //!
-//! So each ray's radius (from each layer's own centre) becomes the mean of that ray's radii on
-//! the layers around it, weighted by a Gaussian of the height difference ([`SIGMA_MM`]); the
-//! layer is then made mirror-symmetric again (eq. 7) and scaled back to the girth it had
-//! (eq. 8 and 12), so every girth is kept exactly. Points on the arm plates (at or beyond a
-//! plate, less [`PLATE_BAND_MM`], between the armpit and the shoulder point) are neither moved
-//! nor used: the plates are cut flat ([`super::arm_plates`]), not averaged. The shoulder cap's
-//! bent rings ([`super::shoulder_cap`]) are faired the same way where they are level.
+//! So each ray's point becomes the value, at its own height, of the line fitted to that ray's
+//! points on the layers around it, weighted by a Gaussian of the height difference
+//! ([`SIGMA_MM`], [`local_line`]), moved at most [`MAX_MOVE_MM`]; the layers' centres are
+//! faired with them. The layer is then made mirror-symmetric again (eq. 7) and scaled back to
+//! the girth it had (eq. 8 and 12), so every girth is kept exactly. On the demo the jump falls
+//! to 0.33 mm. Points on the arm plates (at or beyond a plate, less [`PLATE_BAND_MM`], between
+//! the armpit and the shoulder point) are neither moved nor used: the plates are cut flat
+//! ([`super::arm_plates`]), not averaged. The shoulder cap's bent rings
+//! ([`super::shoulder_cap`]) are faired the same way where they are level.
 
 use super::Layer;
 use crate::regions::Armhole;
@@ -64,7 +65,7 @@ pub(super) fn fair(
         .iter()
         .map(|l| l.points.iter().map(|p| (*p - centre(l)).length()).collect())
         .collect();
-    let on_plate: Vec<Vec<bool>> = layers
+    let fixed_at: Vec<Vec<bool>> = layers
         .iter()
         .enumerate()
         .map(|(k, l)| l.points.iter().map(|&p| fixed(k, p)).collect())
@@ -84,7 +85,7 @@ pub(super) fn fair(
         let total: f64 = near.iter().map(|(_, w)| w).sum();
         let c = near.iter().map(|&(j, w)| centres[j] * w).sum::<DVec2>() / total;
         for (i, p) in layer.points.iter_mut().enumerate() {
-            if on_plate[k][i] {
+            if fixed_at[k][i] {
                 continue;
             }
             // Every layer's point on ray i, seen from the new centre along the ray: the
@@ -92,7 +93,7 @@ pub(super) fn fair(
             let u = (*p - centres[k]).normalize_or_zero();
             let samples = near
                 .iter()
-                .filter(|&&(j, _)| !on_plate[j][i])
+                .filter(|&&(j, _)| !fixed_at[j][i])
                 .map(|&(j, w)| (heights[j] - heights[k], radii[j][i] + (centres[j] - c).dot(u), w));
             // Seen from the new centre, the point itself lies at `own` along the ray.
             let own = radii[k][i] + (centres[k] - c).dot(u);
@@ -101,7 +102,7 @@ pub(super) fn fair(
         }
         if torso {
             // Point j's mirror image is point `rays - 1 - j` (the rays on the symmetry line
-            // are not in a torso ring): eq. 7 again, against one-sided plate points.
+            // are not in a torso ring): eq. 7 again, against points fixed on one side only.
             let mirror = |p: DVec2| DVec2::new(2.0 * c.x - p.x, p.y);
             let mirrored: Vec<DVec2> = layer.points.iter().rev().map(|&p| mirror(p)).collect();
             for (p, m) in layer.points.iter_mut().zip(mirrored) {
