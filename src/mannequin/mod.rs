@@ -20,6 +20,7 @@ mod fairing;
 mod layers;
 mod rebuild;
 mod shoulder_cap;
+mod shoulder_slope;
 mod thighs;
 
 use crate::mesh::Mesh;
@@ -199,8 +200,10 @@ pub fn build(
     let below_cap = torso.iter().take_while(|layer| layer.z < cap.from).count();
     let mut rings = arm_plates::rims(&torso[..below_cap], axis, plates, options.preserve);
     rings.extend(cap.rings.iter().map(|ring| TorsoRing::from_rays(ring)));
-    let mesh =
+    let mut mesh =
         rebuild::rebuild(&rings, cap.neck_centre, &left_leg, &right_leg, axis, landmarks.crotch);
+    let on_plate = |p: DVec3| fairing::on_plates(&plates, p.truncate(), p.z);
+    shoulder_slope::steepen(&mut mesh, axis, cap.from, &on_plate);
     // The legs' layers without the mesh's rings between them.
     let layers_only = |rings: Vec<Layer>| -> Vec<Layer> {
         rings
