@@ -1,6 +1,7 @@
 //! A mannequin a tailor would accept, on every kind of body we have: the demo customer (scanned
-//! with a scanner's artifacts), 20 random customers of the sim generator, its asymmetric
-//! example and the MakeHuman base body. Each test prints its numbers.
+//! with a scanner's artifacts), standing symmetrically and as `dressform demo` poses it, 20
+//! random customers of the sim generator, its asymmetric example and the MakeHuman base body.
+//! Each test prints its numbers.
 //!
 //! Set `DRESSFORM_LOOK=<dir>` to also write every body's input and mannequin there as OBJ, to
 //! render them (`python3 ../shared/tools/look.py out.png <dir>/<name>-mannequin.obj`).
@@ -14,13 +15,14 @@ use common::quality::{
 use common::{largest_mirror_gap, makehuman, surface_mesh as mesh_of};
 use dressform::body_model::BodyModel;
 use dressform::makehuman::{MakeHuman, Pose as MhPose};
-use dressform::mannequin::MannequinOptions;
+use dressform::mannequin::{Layer, Mannequin, MannequinOptions};
 use dressform::mesh::{Mesh, smooth::DEFAULT_PASSES};
 use dressform::pipeline::{Symmetrized, symmetrize};
 use dressform::reconstruct::{ReconstructOptions, reconstruct};
 use dressform::regions::Region;
 use dressform::scan::{self, Scan, format::Format, frame::FrameOptions};
 use dressform::segmented_body::SegmentedBody;
+use dressform::slice::Contour;
 use glam::DVec3;
 use rayon::prelude::*;
 use sim::capture::{Artifacts, BodyParams, Pose, SyntheticBody, capture, generate};
@@ -49,7 +51,12 @@ fn generated(name: String, params: &BodyParams) -> Case {
 
 /// The demo's customer, scanned as the demo scans it, denoised as the commands do.
 fn demo_customer() -> Case {
-    let body = generate(&BodyParams::default()).unwrap();
+    scanned_as_the_demo_does(&BodyParams::default())
+}
+
+/// The body of `params`, scanned as the demo scans it, denoised as the commands do.
+fn scanned_as_the_demo_does(params: &BodyParams) -> Case {
+    let body = generate(params).unwrap();
     let raw = capture(&body, &Artifacts::typical_scanner(0));
     let mut scan =
         scan::from_mesh(mesh_of(&raw), Path::new("demo"), &FrameOptions::default()).unwrap();
@@ -64,6 +71,19 @@ fn asymmetric() -> Case {
     Case { acromions: None, ..generated("asymmetric".into(), &params) }
 }
 
+/// The customer `dressform demo` scans: the demo's customer with the left arm
+/// [`ARM_FURTHER_OUT_DEG`] further out than the right, scanned and denoised as the demo does.
+/// Its armpits are about 22 mm apart (the left 1280, the right 1258 mm).
+fn arm_out() -> Case {
+    let mut params = BodyParams::default();
+    params.pose.left_arm.abduction_deg += ARM_FURTHER_OUT_DEG;
+    Case { name: "arm-out".into(), ..scanned_as_the_demo_does(&params) }
+}
+
+/// How much further out `dressform demo`'s customer holds the left arm (degrees), as the
+/// demo poses it (`cli::demo::ARM_FURTHER_OUT_DEG`).
+const ARM_FURTHER_OUT_DEG: f64 = 15.0;
+
 fn makehuman_base() -> Option<Case> {
     let dir = makehuman()?;
     let scan = scan::load(&dir.join("base.obj"), &FrameOptions::default()).unwrap();
@@ -76,6 +96,9 @@ struct Report {
     name: String,
     /// The width jump below the shoulder points: (mm, height).
     width_jump: (f64, f64),
+    /// The most a torso layer under the mannequin's armpits reaches beyond the body's torso
+    /// under its own armpits: (mm, its height; see [`underarm_excess`]).
+    underarm_excess: (f64, f64),
     self_intersections: usize,
     /// Near-horizontal faces between the crotch and 50 mm above it: (total, largest), mm².
     crotch_ledge: (f64, f64),
@@ -309,6 +332,41 @@ fn crotch_on_plane(mesh: &Mesh, axis: f64) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// How far below the mannequin's armpits [`underarm_excess`] looks (mm): the underarm's
+/// hollow, and a layer's spacing more.
+const UNDERARM_DEPTH_MM: f64 = 30.0;
+
+/// The most a torso layer under the mannequin's armpits may reach beyond the body's torso
+/// under its own armpits (mm; see [`underarm_excess`]). A layer between two armpits at
+/// different heights keeps its section's girth (eq. 8), which holds one side's underarm, so it
+/// swells a little all round: 3.1 mm on arm-out (armpits 22 mm apart), at most 1.9 mm on the
+/// other bodies. The tab stood out 9.2 mm on arm-out.
+const UNDERARM_EXCESS_MM: f64 = 4.0;
+
+/// The most a torso layer within [`UNDERARM_DEPTH_MM`] below the mannequin's own armpits
+/// reaches further from the plane than the body's torso reaches from its centre line at the
+/// same depth below either of the body's armpits (mm), and that layer's height. Between two
+/// armpits at different heights the body's sections hold one side's underarm only: averaged
+/// into both sides, it stood out under the arm plates as a flat tab (6 mm on `dressform
+/// demo`'s re-posed customer, whose armpits are 14.5 mm apart).
+fn underarm_excess(scan: &SegmentedBody, m: &Mannequin) -> (f64, f64) {
+    let (lm, armpit) = (&m.landmarks, m.own_landmarks().left_armpit);
+    let under: Vec<&Layer> =
+        m.torso.iter().filter(|l| l.z < armpit && l.z >= armpit - UNDERARM_DEPTH_MM).collect();
+    let depth_below = |l: &Layer| [lm.left_armpit, lm.right_armpit].map(|a| a - (armpit - l.z));
+    let heights: Vec<f64> = under.iter().flat_map(|l| depth_below(l)).collect();
+    let reach = |c: &Option<Contour>, side: f64| {
+        let c = c.as_ref().expect("a torso section below an armpit");
+        c.points.iter().map(|p| side * (p.x - lm.centre_x)).fold(f64::NEG_INFINITY, f64::max)
+    };
+    let half = |l: &Layer| l.points.iter().map(|p| (p.x - m.axis).abs()).fold(0.0, f64::max);
+    under
+        .iter()
+        .zip(scan.torso_sections(&heights).chunks_exact(2))
+        .map(|(l, s)| (half(l) - reach(&s[0], 1.0).max(reach(&s[1], -1.0)), l.z))
+        .fold((f64::NEG_INFINITY, f64::NAN), |best, e| if e.0 > best.0 { e } else { best })
+}
+
 fn report(case: &Case, out: &Symmetrized) -> Report {
     let m = &out.mannequin;
     let lm = &m.landmarks;
@@ -370,6 +428,7 @@ fn report(case: &Case, out: &Symmetrized) -> Report {
     Report {
         name: case.name.clone(),
         width_jump: width_jump(&m.mesh, f64::NEG_INFINITY, shoulders),
+        underarm_excess: underarm_excess(&scan, m),
         self_intersections: self_intersecting_pairs(&m.mesh).len(),
         crotch_ledge: near_horizontal_area(&m.mesh, band.0, band.1, HORIZONTAL_TILT_DEG),
         body_crotch_ledge: near_horizontal_area(&body, band.0, band.1, HORIZONTAL_TILT_DEG).0,
@@ -476,9 +535,10 @@ fn check_all(cases: Vec<Case>) {
 /// Prints the table of `reports` and checks every row.
 fn check_reports(reports: Vec<Report>) {
     eprintln!(
-        "{:<12} {:>15} {:>9} {:>22} {:>7} {:>11} {:>9} {:>11} {:>6} {:>7} {:>7} {:>15} {:>13} {:>17} {:>8} {:>14}",
+        "{:<12} {:>15} {:>15} {:>9} {:>22} {:>7} {:>11} {:>9} {:>11} {:>6} {:>7} {:>7} {:>15} {:>13} {:>17} {:>8} {:>14}",
         "mannequin",
         "width jump (z)",
+        "underarm (z)",
         "crossing",
         "ledge mm2: max/all/body",
         "crotch",
@@ -496,10 +556,12 @@ fn check_reports(reports: Vec<Report>) {
     );
     for r in &reports {
         eprintln!(
-            "{:<12} {:>6.1} ({:>6.0}) {:>9} {:>6.1} {:>7.0} {:>7.0} {:>+7.2} {:>5.1}/{:>5.1} {:>4.1}/{:>4.1} {:>5.1}/{:>5.1} {:>6.1} {:>7.3} {:>7.3} {:>7.1}/{:>7.1} {:>6.1}/{:>6.1} {:>5.1} {:>5.1} {:>5.1} {:>8} {:>14}",
+            "{:<12} {:>6.1} ({:>6.0}) {:>6.1} ({:>6.0}) {:>9} {:>6.1} {:>7.0} {:>7.0} {:>+7.2} {:>5.1}/{:>5.1} {:>4.1}/{:>4.1} {:>5.1}/{:>5.1} {:>6.1} {:>7.3} {:>7.3} {:>7.1}/{:>7.1} {:>6.1}/{:>6.1} {:>5.1} {:>5.1} {:>5.1} {:>8} {:>14}",
             r.name,
             r.width_jump.0,
             r.width_jump.1,
+            r.underarm_excess.0,
+            r.underarm_excess.1,
             r.self_intersections,
             r.crotch_ledge.1,
             r.crotch_ledge.0,
@@ -532,6 +594,11 @@ fn check_reports(reports: Vec<Report>) {
         let name = &r.name;
         assert_eq!(r.self_intersections, 0, "{name}: self-intersecting triangle pairs");
         assert!(r.width_jump.0 <= WIDTH_JUMP_MM, "{name}: width jump {:?}", r.width_jump);
+        assert!(
+            r.underarm_excess.0 <= UNDERARM_EXCESS_MM,
+            "{name}: a tab under the arm plates: {:?}",
+            r.underarm_excess
+        );
         // Over the whole height, the shoulders too: the mannequin's shoulder top is never
         // flatter than a dress form's, even where the body's is (MakeHuman's, 126 mm).
         assert!(
@@ -584,7 +651,7 @@ fn check_reports(reports: Vec<Report>) {
 
 #[test]
 fn the_demo_customer_the_asymmetric_example_and_the_makehuman_body() {
-    let mut cases = vec![demo_customer(), asymmetric()];
+    let mut cases = vec![demo_customer(), asymmetric(), arm_out()];
     cases.extend(makehuman_base());
     check_all(cases);
 }

@@ -25,6 +25,7 @@
 //! kept only where the rim is at most [`Bottom::half_width`] from its middle, and the ring's
 //! side beyond is drawn back off the plate ([`narrow`]).
 
+use super::fairing::PLATE_BAND_MM;
 use super::rebuild::TorsoRing;
 use super::{Layer, smoothstep};
 use crate::regions::Armhole;
@@ -241,15 +242,26 @@ fn corner(before: DVec2, at: DVec2, inside: &impl Fn(DVec2) -> f64) -> Option<DV
 }
 
 /// `points` cut at the plate on `side` (`inside` its torso side), the chord laid on it and its
-/// corners put back (see the module documentation).
+/// corners put back (see the module documentation). A side that stops short of the plate by
+/// less than [`PLATE_BAND_MM`] (on it, as the fairing takes it) has its points within that
+/// band laid on it: eq. 8 scales a layer about its centre to its section's girth, which can
+/// draw a chord back off the plate (0.4 mm on the demo's re-posed customer, whose lowest ring
+/// on the plates then kept its whole 26 mm chord under the rim's round bottom: a flat tab).
 fn cut_side(points: &mut Vec<DVec2>, axis: f64, side: f64, inside: &impl Fn(DVec2) -> f64) {
-    *points = Contour { points: std::mem::take(points) }.keep_where(inside).points;
-    let Some((first, last)) = chord_ends(points, axis, side, inside) else { return };
     // `inside` is linear: its gradient is the plate's inward normal in the plane.
     let normal =
         DVec2::new(inside(DVec2::X) - inside(DVec2::ZERO), inside(DVec2::Y) - inside(DVec2::ZERO));
+    let onto = |p: DVec2| p - normal * (inside(p) / normal.length_squared().max(f64::MIN_POSITIVE));
+    *points = Contour { points: std::mem::take(points) }.keep_where(inside).points;
+    if chord_ends(points, axis, side, inside).is_none() {
+        let near = |p: &DVec2| side * (p.x - axis) > 0.0 && inside(*p) <= PLATE_BAND_MM;
+        for p in points.iter_mut().filter(|p| near(p)) {
+            *p = onto(*p);
+        }
+    }
+    let Some((first, last)) = chord_ends(points, axis, side, inside) else { return };
     for p in &mut points[first + 1..last] {
-        *p -= normal * (inside(*p) / normal.length_squared().max(f64::MIN_POSITIVE));
+        *p = onto(*p);
     }
     let n = points.len();
     let same_side = |k: usize| side * (points[k].x - axis) > 0.0;

@@ -42,8 +42,9 @@ const REACH_SIGMAS: f64 = 3.0;
 const MAX_MOVE_MM: f64 = 1.0;
 
 /// A point this close to an arm plate (mm), or beyond it, is on the plate: the averaged chord
-/// of an asymmetric body strays from the mannequin's own plate by about a millimetre.
-const PLATE_BAND_MM: f64 = 2.0;
+/// of an asymmetric body strays from the mannequin's own plate by about a millimetre. The
+/// plates' rims lay a side this close on its plate ([`super::arm_plates`]).
+pub(super) const PLATE_BAND_MM: f64 = 2.0;
 
 /// Fairs `layers` (bottom to top, one region, each with the same number of rays) in place
 /// (see the module docs); `fixed(k, p)`: point `p` of layer `k` is neither moved nor used

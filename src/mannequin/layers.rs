@@ -1,5 +1,6 @@
 //! Cutting the torso and legs into layers and making each symmetric.
 
+use super::side_heights::SideHeights;
 use super::{Layer, MannequinError, MannequinOptions};
 use crate::regions::{Region, largest_with};
 use crate::segmented_body::SegmentedBody;
@@ -105,23 +106,30 @@ pub(super) fn symmetric_layers(
             .into_iter()
             .unzip();
 
-    // Torso sections, with the arms cut off above the armpits.
-    let torso_sections: Vec<(f64, Contour)> = torso_z
-        .iter()
-        .zip(body.torso_sections(&torso_z))
-        .map(|(&z, c)| {
-            c.map(|c| (z, c)).ok_or(MannequinError::MissingLoop { region: Region::Torso, z })
-        })
-        .collect::<Result<_, _>>()?;
-    let mut centres: Vec<f64> = torso_sections.iter().map(|(_, c)| c.bbox_centre().x).collect();
+    // Torso sections, with the arms cut off above the armpits: at each layer's height (its
+    // girth, and the symmetry plane), and where its halves are taken from.
+    let missing = |z| MannequinError::MissingLoop { region: Region::Torso, z };
+    let cut = |heights: &[f64]| -> Result<Vec<Contour>, MannequinError> {
+        let found = heights.iter().zip(body.torso_sections(heights));
+        found.map(|(&z, c)| c.ok_or(missing(z))).collect()
+    };
+    let torso_sections = cut(&torso_z)?;
+    let sides = SideHeights::of(m);
+    let side_z: Vec<f64> = torso_z.iter().flat_map(|&z| sides.at(z)).collect();
+    let side_sections = cut(&side_z)?;
+    let mut centres: Vec<f64> = torso_sections.iter().map(|c| c.bbox_centre().x).collect();
     centres.sort_by(f64::total_cmp);
     let axis = centres[centres.len() / 2];
 
-    let torso = torso_sections
+    let torso = torso_z
         .iter()
-        .map(|(z, c)| {
-            let ring = axial::symmetrize(c, axis, o.rays, o.preserve)?;
-            Ok(layer(Region::Torso, *z, ring.centre, ring.points, c))
+        .zip(&torso_sections)
+        .zip(side_sections.chunks_exact(2))
+        .map(|((&z, c), halves)| {
+            let (left, right) = (&halves[0], &halves[1]);
+            let girth = o.preserve.girth(c);
+            let ring = axial::symmetrize_halves(left, right, axis, o.rays, o.preserve, girth)?;
+            Ok(layer(Region::Torso, z, ring.centre, ring.points, c))
         })
         .collect::<Result<Vec<_>, MannequinError>>()?;
 

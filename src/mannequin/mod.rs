@@ -6,7 +6,9 @@
 //! scanner's leftover noise, girths kept ([`fairing`]). Above the armpits the torso sections
 //! are cut at the armholes ([`crate::regions::Armhole`]), so the arms are not part of the
 //! torso: the cut edges stack into flat arm plates, each rimmed by one smooth curve
-//! ([`arm_plates`]). Every torso layer is horizontal and keeps
+//! ([`arm_plates`]). Near the armpits each side's half of a torso layer is taken at the height
+//! aligned by that side's own armpit ([`side_heights`]), so armpits at different heights put
+//! no underarm under the plates. Every torso layer is horizontal and keeps
 //! its section's girth; above the arm plates the mesh is built from rings bent up over the
 //! shoulders, which follow the shoulder top with its own slope ([`shoulder_cap`]). Within
 //! 100 mm below the crotch the legs' mesh has rings between their layers, finer towards the
@@ -21,6 +23,7 @@ mod layers;
 mod rebuild;
 mod shoulder_cap;
 mod shoulder_slope;
+mod side_heights;
 mod thighs;
 
 use crate::mesh::Mesh;
@@ -62,7 +65,9 @@ pub struct Layer {
     /// The ring, counter-clockwise from above, starting at the front (see [`crate::symmetry`]).
     #[serde(serialize_with = "serialize_points")]
     pub points: Vec<DVec2>,
-    /// The input section's tape girth (mm).
+    /// The input section's tape girth (mm): the body's torso section at the layer's height,
+    /// whose girth the layer keeps (eq. 8). Near the armpits the layer's shape comes from each
+    /// side's section at another height ([`side_heights`]); its girth is still this one's.
     pub input_tape_girth: f64,
     /// The input section's contour length (mm).
     pub input_contour_length: f64,

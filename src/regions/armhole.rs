@@ -13,6 +13,7 @@
 //! raised arm (the notch where the arm begins, below the chord instead of above it).
 
 use super::contact::Contact;
+use super::tracking::BISECTION_MM;
 use crate::mesh::Mesh;
 use crate::slice::Contour;
 use glam::{DVec2, DVec3};
@@ -75,9 +76,12 @@ impl Armhole {
 
     /// The part of the horizontal loop `c` at height `z` on the torso's side of the plate;
     /// below the armpit the loop is returned whole, or, where the arm rests on the torso,
-    /// cut along the contact.
+    /// cut along the contact. The plate cuts from [`BISECTION_MM`] below the armpit: the
+    /// armpit is the top of its bisection's last interval, so the arm may have joined the
+    /// torso's loop that far below it (a torso layer 0.04 mm below both armpits of the
+    /// generator's random-12 held both arms).
     pub fn clip(&self, c: &Contour, z: f64) -> Contour {
-        if z < self.armpit.z {
+        if z < self.armpit.z - BISECTION_MM {
             return match self.contact {
                 Some(contact) if z >= contact.from => {
                     c.clip_half_plane(contact.normal, contact.offset)

@@ -52,12 +52,17 @@ fn between(body: &Mesh, below: f64, above: f64) -> Mesh {
     })
 }
 
+/// The landmarks' bisections stop when the interval is this short (mm). Each landmark is the
+/// top of its last interval, the first height found changed (the legs or an arm joined, the
+/// neck under a resting arm opened), so the change may begin up to this far below it.
+pub(super) const BISECTION_MM: f64 = 0.1;
+
 /// The crotch between `below` (the legs apart, their loops around `legs`) and `above` (one
-/// loop around both), by bisection to 0.1 mm, cutting only the part of the body between the
-/// two heights.
+/// loop around both), by bisection to [`BISECTION_MM`], cutting only the part of the body
+/// between the two heights.
 fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, legs: [&Contour; 2]) -> f64 {
     let near = between(body, below, above);
-    while above - below > 0.1 {
+    while above - below > BISECTION_MM {
         let mid = 0.5 * (below + above);
         let s = &sections(&near, &[mid])[0];
         let [l, r] = legs.map(|c| continuing(s, c));
@@ -72,9 +77,9 @@ fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, legs: [&Contour; 2
 const SHIN_LEVEL: f64 = 0.15;
 
 /// The armpit between `below` (the arm's loop `arm` apart from the torso's loop `torso`)
-/// and `above` (joined), by bisection to 0.1 mm: the middle of the narrowest gap between the
-/// arm and the torso just below where they join. The arm grows upward into the join, so a
-/// level holds it apart as long as the torso's loop there does not overlap `arm`.
+/// and `above` (joined), by bisection to [`BISECTION_MM`]: the middle of the narrowest gap
+/// between the arm and the torso just below where they join. The arm grows upward into the
+/// join, so a level holds it apart as long as the torso's loop there does not overlap `arm`.
 fn refine_armpit(
     body: &Mesh,
     mut below: f64,
@@ -85,7 +90,7 @@ fn refine_armpit(
     let near = between(body, below, above);
     let torso_c = torso.centroid();
     let mut apart = (arm.clone(), torso.clone());
-    while above - below > 0.1 {
+    while above - below > BISECTION_MM {
         let mid = 0.5 * (below + above);
         let s = &sections(&near, &[mid])[0];
         let torso_here = loop_containing(s, torso_c).map(|t| &s.loops[t]);
@@ -105,8 +110,8 @@ fn refine_armpit(
 /// The armpit of an arm that rests on the torso (see [`super::contact`]): going up the
 /// torso's tracked loops `up` from the join (arm `arm` apart from the torso's loop on level
 /// `join.level`, joined from `joined` mm), the first level where the neck between them has
-/// opened, refined by bisection to 0.1 mm; `None` when the neck is open on the first joined
-/// level (an arm that leaves the torso at an angle: its armpit is where the loops join).
+/// opened, refined by bisection to [`BISECTION_MM`]; `None` when the neck is open on the first
+/// joined level (an arm that leaves the torso at an angle: its armpit is where the loops join).
 fn top_of_contact(
     body: &Mesh,
     levels: &[Section],
@@ -130,7 +135,7 @@ fn top_of_contact(
     let (mut below, mut top) = (grid.z(closed_level), grid.z(above[first_open].0));
     let near = between(body, below, top);
     let centre = torso.centroid();
-    while top - below > 0.1 {
+    while top - below > BISECTION_MM {
         let mid = 0.5 * (below + top);
         let s = &sections(&near, &[mid])[0];
         let neck = loop_containing(s, centre).and_then(|t| neck_of(&s.loops[t]));
@@ -166,9 +171,9 @@ fn reach(c: &Contour, sign: f64, centre: f64) -> f64 {
 }
 
 /// The armpit of an arm that grows straight out of the torso's loop between `below` (the
-/// torso's loop `torso` there, not yet joined) and `above`, by bisection to 0.1 mm: the
-/// torso's outermost point on side `sign` at the highest level where its reach has not yet
-/// jumped by [`ARM_JUMP_MM`] — the crease under the arm.
+/// torso's loop `torso` there, not yet joined) and `above`, by bisection to [`BISECTION_MM`]:
+/// the torso's outermost point on side `sign` at the highest level where its reach has not
+/// yet jumped by [`ARM_JUMP_MM`] — the crease under the arm.
 fn refine_outgrowth(
     body: &Mesh,
     mut below: f64,
@@ -180,7 +185,7 @@ fn refine_outgrowth(
     let (torso_c, centre) = (torso.centroid(), torso.bbox_centre().x);
     let limit = reach(torso, sign, centre) + ARM_JUMP_MM;
     let mut apart = torso.clone();
-    while above - below > 0.1 {
+    while above - below > BISECTION_MM {
         let mid = 0.5 * (below + above);
         let s = &sections(&near, &[mid])[0];
         match loop_containing(s, torso_c).map(|t| &s.loops[t]) {

@@ -56,7 +56,13 @@ pub fn cast_along(contour: &Contour, centre: DVec2, directions: &[DVec2]) -> Vec
 /// holds its bounding-box centre: from there the rays towards the back miss the loop, and each
 /// would take the loop's extent, a flap behind the buttocks.
 pub fn ray_origin(contour: &Contour) -> DVec2 {
-    let c = contour.bbox_centre();
+    ray_origin_at(contour, contour.bbox_centre())
+}
+
+/// `c`, or, where it lies outside `contour`, the middle of the longest stretch of the vertical
+/// line through it that lies inside (`c` itself where that line misses the contour): the
+/// rays' origin of [`ray_origin`] for any centre `c`.
+pub fn ray_origin_at(contour: &Contour, c: DVec2) -> DVec2 {
     if contour.contains(c) {
         return c;
     }
