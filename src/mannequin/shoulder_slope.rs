@@ -76,19 +76,13 @@ const NECK_CAP_MM: f64 = 1e-6;
 /// points (1 degree of a 150 mm shoulder apart, 2.6 mm).
 const BIN_MM: f64 = 0.5;
 
-/// The silhouette's top over `u` (distance from the plane x = `axis`) of the triangles of
-/// `mesh` that reach above `from`, in bins of [`BIN_MM`] from 0: the highest point of their
-/// edges (a triangle's highest point at any `u` is on one of them). Bins no edge reaches are
-/// interpolated.
-fn silhouette_top(mesh: &Mesh, axis: f64, from: f64) -> Vec<f64> {
+/// The silhouette's top over `u` (distance from the plane x = `axis`) of the `triangles` of
+/// `mesh`, in bins of [`BIN_MM`] from 0: the highest point of their edges (a triangle's
+/// highest point at any `u` is on one of them). Bins no edge reaches are interpolated.
+fn silhouette_top(mesh: &Mesh, triangles: &[usize], axis: f64) -> Vec<f64> {
     let u = |p: DVec3| (p.x - axis).abs();
-    let above = |t: &[u32; 3]| t.iter().any(|&v| mesh.positions[v as usize].z > from);
-    let triangles: Vec<[DVec3; 3]> = mesh
-        .triangles
-        .iter()
-        .filter(|t| above(t))
-        .map(|t| t.map(|v| mesh.positions[v as usize]))
-        .collect();
+    let triangles: Vec<[DVec3; 3]> =
+        triangles.iter().map(|&t| mesh.triangles[t].map(|v| mesh.positions[v as usize])).collect();
     let reach = triangles.iter().flatten().map(|&p| u(p)).fold(0.0, f64::max);
     let mut top = vec![f64::NEG_INFINITY; (reach / BIN_MM).ceil() as usize + 1];
     for [a, b, c] in triangles {
@@ -103,6 +97,12 @@ fn silhouette_top(mesh: &Mesh, axis: f64, from: f64) -> Vec<f64> {
     }
     fill_gaps(&mut top);
     top
+}
+
+/// The triangles of `mesh` with a corner above `from`.
+fn reaching_above(mesh: &Mesh, from: f64) -> Vec<usize> {
+    let above = |t: &[u32; 3]| t.iter().any(|&v| mesh.positions[v as usize].z > from);
+    (0..mesh.triangles.len()).filter(|&t| above(&mesh.triangles[t])).collect()
 }
 
 /// Replaces the non-finite entries of `values` by linear interpolation between their finite
@@ -153,12 +153,14 @@ pub(super) fn steepen(mesh: &mut Mesh, axis: f64, from: f64, fixed: &dyn Fn(DVec
         .map(|p| (p.x - axis).abs())
         .fold(0.0, f64::max);
     bisect_long_edges(mesh, axis, from, fixed);
+    // Raised, they stay above `from`.
+    let cap = reaching_above(mesh, from);
     let rise = MIN_SLOPE_DEG.to_radians().tan();
     // A vertex below the top is raised less than the top, and an edge from it may be the
     // silhouette: each pass leaves a fraction of the shortfall, the next one raises it again.
     let mut shortfall = f64::INFINITY;
     for _ in 0..MAX_PASSES {
-        let top = silhouette_top(mesh, axis, from);
+        let top = silhouette_top(mesh, &cap, axis);
         let least: Vec<f64> = sloped_envelope(&top, rise)
             .iter()
             .zip(&top)
@@ -199,7 +201,9 @@ pub(super) fn steepen(mesh: &mut Mesh, axis: f64, from: f64, fixed: &dyn Fn(DVec
 fn bisect_long_edges(mesh: &mut Mesh, axis: f64, from: f64, fixed: &dyn Fn(DVec3) -> bool) {
     let key = |a: u32, b: u32| (a.min(b), a.max(b));
     let mut beside: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-    for (t, tri) in mesh.triangles.iter().enumerate() {
+    // An edge reaching above `from` has both its triangles among those that do.
+    for t in reaching_above(mesh, from) {
+        let tri = mesh.triangles[t];
         for k in 0..3 {
             beside.entry(key(tri[k], tri[(k + 1) % 3])).or_default().push(t);
         }
@@ -327,10 +331,10 @@ mod tests {
         };
         let mut mesh = body(720, from, 200.0, half_width);
         let unmoved = mesh.clone();
-        let before = silhouette_top(&mesh, 0.0, from);
+        let before = silhouette_top(&mesh, &reaching_above(&mesh, from), 0.0);
         assert!(slope(&before, 90.0, 150.0) < 0.06, "the shelf is nearly level");
         steepen(&mut mesh, 0.0, from, &|_| false);
-        let after = silhouette_top(&mesh, 0.0, from);
+        let after = silhouette_top(&mesh, &reaching_above(&mesh, from), 0.0);
         let rise = MIN_SLOPE_DEG.to_radians().tan();
         for u in [90.0, 120.0, 150.0] {
             assert!(slope(&after, u - 5.0, u + 5.0) >= rise - 1e-3, "flat at {u}");
