@@ -12,8 +12,8 @@
 //! shoulder cap into the arm's side), an A-pose (it bends into the arm's upper side) and a
 //! raised arm (the notch where the arm begins, below the chord instead of above it).
 
+use super::BISECTION_MM;
 use super::contact::Contact;
-use super::tracking::BISECTION_MM;
 use crate::mesh::Mesh;
 use crate::slice::Contour;
 use glam::{DVec2, DVec3};

@@ -21,6 +21,12 @@ use crate::slice::{Contour, Section, sections};
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
+/// The landmarks' bisections stop when the interval is this short (mm). Each landmark is the
+/// top of its last interval, the first height found changed (the legs or an arm joined, the
+/// neck under a resting arm opened), so the change may begin up to this far below it
+/// ([`tracking`] finds them, an [`Armhole`] cuts from that far below its armpit).
+const BISECTION_MM: f64 = 0.1;
+
 /// The part of the body a loop belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

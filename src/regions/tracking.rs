@@ -2,7 +2,7 @@
 
 use super::armhole::{self, Armhole};
 use super::contact::{Contact, Neck, NeckGauge};
-use super::{BodyRegions, LabelledSection, Landmarks, Region, RegionError, side};
+use super::{BISECTION_MM, BodyRegions, LabelledSection, Landmarks, Region, RegionError, side};
 use crate::mesh::Mesh;
 use crate::slice::{Contour, Section, sections};
 use glam::{DVec2, DVec3};
@@ -51,11 +51,6 @@ fn between(body: &Mesh, below: f64, above: f64) -> Mesh {
         z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
     })
 }
-
-/// The landmarks' bisections stop when the interval is this short (mm). Each landmark is the
-/// top of its last interval, the first height found changed (the legs or an arm joined, the
-/// neck under a resting arm opened), so the change may begin up to this far below it.
-pub(super) const BISECTION_MM: f64 = 0.1;
 
 /// The crotch between `below` (the legs apart, their loops around `legs`) and `above` (one
 /// loop around both), by bisection to [`BISECTION_MM`], cutting only the part of the body
