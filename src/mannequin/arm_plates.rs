@@ -10,10 +10,12 @@
 //! So each mesh ring in that zone is cut again at the mannequin's own (mirror-symmetric) arm
 //! plates, the points between a side's two corners are laid on the plate (the averaged chord
 //! of an asymmetric body strays from it by the asymmetry), and each corner is put back where
-//! the ring's side, continued straight, meets the plate; the ring is then stretched front to
-//! back until it has its layer's girth again (the plates run front to back, so the chords stay
-//! on them). Where two neighbouring rings both meet the plates, the band between them is
-//! stitched with their corners' parameters aligned, so corner meets corner
+//! the ring's side, continued straight, meets the plate; the ring's sides are then stretched
+//! front to back until it has its layer's girth again (the plates run front to back, so the
+//! chords stay on them; the front and back stay where the faired layer has them: stretched
+//! whole, they stood 1.1 mm out across the demo's back near the plate bottom, a band). Where
+//! two neighbouring rings both meet the plates, the band between them is stitched with their
+//! corners' parameters aligned, so corner meets corner
 //! ([`super::rebuild`]): the rim is one curve through the rings' corners, and the plate inside
 //! it is flat. The torso layers themselves (`profiles.json`) keep their rays.
 //!
@@ -367,16 +369,19 @@ fn rim(
         cut_side(&mut points, axis, side, inside);
     }
     let girth = preserve.girth(&Contour { points: layer.points.clone() });
+    let half = |points: &[DVec2]| points.iter().map(|p| (p.x - axis).abs()).fold(0.0, f64::max);
+    // The girth the cut changed, given back beside the plates (see [`lateral`]).
     if chord_ends(&points, axis, 1.0, &insides[0]).is_some() {
-        points = with_girth(&points, centre.y, girth, preserve, |_| 1.0);
+        let half = half(&points);
+        points = with_girth(&points, centre.y, girth, preserve, |p| lateral(p, axis, half));
     }
     if let Some((bottom, below)) = bottom {
         let kept = (bottom.middle, bottom.half_width(z), bottom.slack(z));
         for (inside, side) in insides.iter().zip([1.0, -1.0]) {
             narrow(&mut points, axis, side, inside, kept, below);
         }
-        // The girth the drawn-back sides lost, given back beside them (see [`lateral`]).
-        let half = points.iter().map(|p| (p.x - axis).abs()).fold(0.0, f64::max);
+        // The girth the drawn-back sides lost, given back beside them.
+        let half = half(&points);
         points = with_girth(&points, centre.y, girth, preserve, |p| lateral(p, axis, half));
     }
     let chords: Vec<(usize, usize)> = insides
@@ -420,6 +425,40 @@ mod tests {
         assert!((Contour { points: flat.clone() }.tape_girth() - girth).abs() < 1e-6);
         for p in &flat {
             assert!(flat.iter().any(|q| (q.x + p.x).abs() < 1e-9 && (q.y - p.y).abs() < 1e-9));
+        }
+    }
+
+    #[test]
+    fn the_girth_a_cut_takes_is_given_back_beside_the_plates() {
+        // The plates 5 mm inside the layer's cut sides: cutting again takes girth, and it is
+        // given back at the sides; the front and back stay where the layer has them
+        // (stretched whole, they stood out as a line across the back).
+        let layer = cut_ellipse(130.0, 90.0, 50.0);
+        let plate = |x: f64, side: f64| {
+            Armhole::through(DVec3::new(x, 0.0, 0.0), DVec3::new(x, 0.0, 100.0), DVec3::NEG_Y, side)
+        };
+        let (left, right) = (plate(95.0, 1.0), plate(-95.0, -1.0));
+        let rimmed = rim(&layer, 0.0, [&left, &right], Preserve::Tape, None);
+        let flat: Vec<DVec2> = rimmed.points.iter().map(|p| p.truncate()).collect();
+        let girth = Contour { points: flat.clone() }.tape_girth();
+        assert!((girth - layer.tape_girth).abs() < 1e-6, "{girth} against {}", layer.tape_girth);
+        // Where a ring crosses the midline x = 0, front to back.
+        let middle = |points: &[DVec2]| -> Vec<f64> {
+            let n = points.len();
+            let mut ys: Vec<f64> = (0..n)
+                .filter_map(|k| {
+                    let (a, b) = (points[k], points[(k + 1) % n]);
+                    (a.x > 0.0 && b.x <= 0.0 || a.x <= 0.0 && b.x > 0.0)
+                        .then(|| a.y + (b.y - a.y) * a.x / (a.x - b.x))
+                })
+                .collect();
+            ys.sort_by(f64::total_cmp);
+            ys
+        };
+        let (kept, own) = (middle(&flat), middle(&layer.points));
+        assert_eq!((kept.len(), own.len()), (2, 2), "the front and the back");
+        for (a, b) in kept.iter().zip(&own) {
+            assert!((a - b).abs() < 1e-9, "the midline moved from {b} to {a}");
         }
     }
 
