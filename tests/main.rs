@@ -7,6 +7,7 @@ mod analytic_sections;
 mod bad_input;
 mod body_model;
 mod canonical_frame;
+mod controller_claim;
 mod controller_cli;
 mod controller_estop;
 mod controller_pty;

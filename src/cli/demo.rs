@@ -7,7 +7,7 @@
 //! pose-symmetric scan's and the mannequin's.
 
 use super::drive::{SimArgs, shape_verdict};
-use super::run::{Drive, Reconstruct, shape_form};
+use super::run::{Drive, Prepared, Reconstruct, shape_form};
 use super::{Failure, progress_bar};
 use dressform::body_model::BodyModel;
 use dressform::controller::{DriveOptions, LinkSpec};
@@ -19,8 +19,8 @@ use dressform::report::ScanInfo;
 use dressform::scan::format::{Export, Format, Placement};
 use dressform::scan::{self, frame::FrameOptions, frame::Units};
 use glam::DVec3;
-use sim::capture::{Artifacts, BodyParams, Pose, capture, generate};
-use std::path::PathBuf;
+use sim::capture::{Artifacts, BodyParams, GroundTruth, Pose, capture, generate};
+use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]
 pub struct DemoArgs {
@@ -50,67 +50,16 @@ fn asymmetric(mut pose: Pose) -> Pose {
 }
 
 pub fn run(args: &DemoArgs) -> Result<(), Failure> {
-    let bar = progress_bar(false, 3);
-    let params = args.seed.map_or_else(BodyParams::default, BodyParams::random);
-    let params = BodyParams { pose: asymmetric(params.pose), ..params };
-    bar.set_message("generating the customer");
-    let customer = generate(&params).map_err(Failure::other)?;
-    bar.inc(1);
-    bar.set_message("scanning");
-    let artifacts = Artifacts::typical_scanner(args.seed.unwrap_or(0));
-    let raw = capture(&customer, &artifacts);
-    let raw =
-        Mesh::new(raw.positions.iter().map(|&p| DVec3::from_array(p)).collect(), raw.triangles);
-    let scanner = Placement::AsIs {
-        units: Units::M,
-        frame: format!("the scanner's: Y up, turned {} degrees", artifacts.yaw_deg),
-    };
-    let scan_file = Export::new(Format::Ply, scanner).map_err(Failure::other)?.encode(&raw);
-    let scan_path = args.out.join("scan.ply");
-    bar.inc(1);
-    bar.set_message("reading the scan back");
-    let mut scan = scan::from_bytes(&scan_file, &scan_path, &FrameOptions::default())
-        .map_err(Failure::bad_input)?;
-    let mut outputs = OutputSet::new();
-    outputs.add("scan.ply", scan_file);
-    let info = ScanInfo::new(&scan);
-    scan.body.taubin_smooth(DEFAULT_PASSES);
-    bar.finish_and_clear();
-
-    let truth = &customer.truth;
-    outln!(
-        "A synthetic customer: {:.0} mm tall, chest {:.0}, waist {:.0}, hip {:.0} mm, crotch height {:.0} mm.",
-        truth.height_mm,
-        truth.chest.tape_girth_mm,
-        truth.waist.tape_girth_mm,
-        truth.hip.tape_girth_mm,
-        truth.crotch_height_mm
-    );
-    let pose = &params.pose;
-    outln!(
-        "It stands with the left arm {:.0} degrees out and the right {:.0}, the left leg {:.0} and the right {:.0}.",
-        pose.left_arm.abduction_deg,
-        pose.right_arm.abduction_deg,
-        pose.left_leg.abduction_deg,
-        pose.right_leg.abduction_deg
-    );
-    outln!(
-        "Scanned with {:.1} mm noise, holes at the armpits, crotch and soles, in metres, Y up, turned {:.0} degrees:",
-        artifacts.noise_sigma_mm,
-        artifacts.yaw_deg
-    );
-    out!("{info}");
-    outln!();
     let drive = Drive {
         link: &LinkSpec::Sim,
         sim: &SimArgs::default(),
         options: &DriveOptions::default(),
         girth_tolerance: DEFAULT_GIRTH_TOLERANCE_MM,
     };
-    let model = BodyModel::builtin();
-    let reconstruct = Reconstruct { model: &model, options: &ReconstructOptions::default() };
     let form = form_description::reference();
-    let (done, shape) = shape_form(&scan, &reconstruct, &form, &drive, &args.out, outputs)?;
+    let (seed, out) = (args.seed, args.out.clone());
+    // The customer is made and scanned once the simulated form is claimed (see `shape_form`).
+    let (done, shape, truth) = shape_form(&form, &drive, &args.out, move || customer(seed, &out))?;
     outln!();
     outln!(
         "  {:<12} {:>9} {:>9} {:>11} {:>11}",
@@ -148,4 +97,65 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         args.out.display()
     );
     shape_verdict(&shape)
+}
+
+/// The synthetic customer of `seed` (the default one without), standing asymmetrically and
+/// scanned with a typical scanner's artifacts, its scan encoded as PLY into the outputs and
+/// read back; what it is and how it was scanned printed. Returns the prepared scan and the
+/// customer's true measurements.
+fn customer(seed: Option<u64>, out: &Path) -> Result<Prepared<GroundTruth>, Failure> {
+    let bar = progress_bar(false, 3);
+    let params = seed.map_or_else(BodyParams::default, BodyParams::random);
+    let params = BodyParams { pose: asymmetric(params.pose), ..params };
+    bar.set_message("generating the customer");
+    let customer = generate(&params).map_err(Failure::other)?;
+    bar.inc(1);
+    bar.set_message("scanning");
+    let artifacts = Artifacts::typical_scanner(seed.unwrap_or(0));
+    let raw = capture(&customer, &artifacts);
+    let raw =
+        Mesh::new(raw.positions.iter().map(|&p| DVec3::from_array(p)).collect(), raw.triangles);
+    let scanner = Placement::AsIs {
+        units: Units::M,
+        frame: format!("the scanner's: Y up, turned {} degrees", artifacts.yaw_deg),
+    };
+    let scan_file = Export::new(Format::Ply, scanner).map_err(Failure::other)?.encode(&raw);
+    let scan_path = out.join("scan.ply");
+    bar.inc(1);
+    bar.set_message("reading the scan back");
+    let mut scan = scan::from_bytes(&scan_file, &scan_path, &FrameOptions::default())
+        .map_err(Failure::bad_input)?;
+    let mut outputs = OutputSet::new();
+    outputs.add("scan.ply", scan_file);
+    let info = ScanInfo::new(&scan);
+    scan.body.taubin_smooth(DEFAULT_PASSES);
+    bar.finish_and_clear();
+
+    let truth = &customer.truth;
+    outln!(
+        "A synthetic customer: {:.0} mm tall, chest {:.0}, waist {:.0}, hip {:.0} mm, crotch height {:.0} mm.",
+        truth.height_mm,
+        truth.chest.tape_girth_mm,
+        truth.waist.tape_girth_mm,
+        truth.hip.tape_girth_mm,
+        truth.crotch_height_mm
+    );
+    let pose = &params.pose;
+    outln!(
+        "It stands with the left arm {:.0} degrees out and the right {:.0}, the left leg {:.0} and the right {:.0}.",
+        pose.left_arm.abduction_deg,
+        pose.right_arm.abduction_deg,
+        pose.left_leg.abduction_deg,
+        pose.right_leg.abduction_deg
+    );
+    outln!(
+        "Scanned with {:.1} mm noise, holes at the armpits, crotch and soles, in metres, Y up, turned {:.0} degrees:",
+        artifacts.noise_sigma_mm,
+        artifacts.yaw_deg
+    );
+    out!("{info}");
+    outln!();
+    let reconstruct =
+        Reconstruct { model: BodyModel::builtin(), options: ReconstructOptions::default() };
+    Ok(Prepared { scan, reconstruct, outputs, extra: customer.truth })
 }

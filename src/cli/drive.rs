@@ -9,8 +9,8 @@ use std::time::Duration;
 
 use dressform::controller::simulated::SimConfig;
 use dressform::controller::{
-    DEFAULT_TOLERANCE_MM, DriveError, DriveOptions, DriveReport, LinkSpec, Progress, SessionError,
-    drive, plan,
+    Claim, DEFAULT_TOLERANCE_MM, DriveError, DriveOptions, DriveReport, LinkSpec, Progress,
+    SessionError, Transport, plan,
 };
 use dressform::fitting::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
 use dressform::setpoints::SetPoints;
@@ -114,8 +114,10 @@ pub fn run(args: &DriveArgs) -> Result<(), Failure> {
         min_duration,
         ..args.shape.options()
     };
-    let report = execute(&form, &setpoints, &args.link.spec(), &options, &args.sim, args.json)?;
-    let shape = compare(&form, &report.positions_mm, &setpoints.target_girths_mm, girth_tolerance);
+    let target_girths = setpoints.target_girths_mm.clone();
+    let compute = move || Ok(((), setpoints));
+    let ((), report) = execute(&form, &args.link.spec(), &options, &args.sim, args.json, compute)?;
+    let shape = compare(&form, &report.positions_mm, &target_girths, girth_tolerance);
     print_report(&report, &shape, args.json)?;
     shape_verdict(&shape)
 }
@@ -129,18 +131,25 @@ pub fn shape_verdict(shape: &ShapeOutcome) -> Result<(), Failure> {
     }
 }
 
-/// Drives `form` to `setpoints` over `link` (the in-process simulated form for
-/// [`LinkSpec::Sim`], with `sim`'s log and faults), with one progress bar per node (none with
-/// `json`); signals and `dressform estop` from another terminal e-stop the form. A failing
-/// log is reported when it fails, and fails the command once the move is over.
-pub fn execute(
+/// Drives `form` over `link` (the in-process simulated form for [`LinkSpec::Sim`], with
+/// `sim`'s log and faults) to the set-points `compute` returns, with one progress bar per
+/// node (none with `json`).
+///
+/// The form is claimed before `compute` starts ([`Claim::take`]): the link opened, its
+/// control endpoint answering and the signals armed, every node discovered and the e-stops
+/// latched on it recorded. `compute` then runs on a thread of its own while the link is kept
+/// alive ([`Claim::hold_while`]); an e-stop meanwhile — from another terminal, a signal, or
+/// latched on a node — ends the command at once (exit 1; the computation is abandoned, its
+/// outputs are all or nothing) and is never cleared by it. A failing log is reported when it
+/// fails, and fails the command once the move is over.
+pub fn execute<R: Send + 'static>(
     form: &FormDescription,
-    setpoints: &SetPoints,
     link: &LinkSpec,
     options: &DriveOptions,
     sim: &SimArgs,
     json: bool,
-) -> Result<DriveReport, Failure> {
+    compute: impl FnOnce() -> Result<(R, SetPoints), Failure> + Send + 'static,
+) -> Result<(R, DriveReport), Failure> {
     if *link != LinkSpec::Sim && (sim.log.is_some() || sim.faults.is_some()) {
         return Err(Failure::bad_input("--log and --faults go with --sim"));
     }
@@ -154,9 +163,30 @@ pub fn execute(
     let result = runtime.block_on(async {
         let config = SimConfig { faults, log: sim.log.clone(), ..SimConfig::default() };
         let owned = link::own(link, form, &config)?;
-        let driving = drive(owned.connection, form, setpoints, options, progress);
+        let device = owned.connection.device();
+        let mut claim = Claim::take(owned.connection, form).await.map_err(DriveError::from)?;
+        errln!(
+            "{device}: form \"{}\" claimed ({} nodes answer); an e-stop from now on ends this command",
+            form.name,
+            form.nodes.len()
+        );
+        let (computed, result) = tokio::sync::oneshot::channel();
+        std::thread::Builder::new()
+            .name("dressform compute".into())
+            .stack_size(COMPUTE_STACK_BYTES)
+            .spawn(move || {
+                // The receiver is gone only when the command already ended (an e-stop).
+                let _ = computed.send(compute());
+            })
+            .map_err(|e| Failure::other(format!("cannot start the computation: {e}")))?;
+        let (value, setpoints) = match claim.hold_while(result).await {
+            Ok(Ok(done)) => done?,
+            Ok(Err(_)) => return Err(Failure::other("the computation ended without a result")),
+            Err(stopped) => return Err(DriveError::from(stopped).into()),
+        };
+        let driving = claim.drive(&setpoints, options, progress);
         let Some(rig) = owned.rig else {
-            return driving.await.map_err(Failure::from);
+            return Ok((value, driving.await?));
         };
         // The simulated bus's log, watched while the form moves.
         let log_watch = async {
@@ -173,11 +203,15 @@ pub fn execute(
             () = log_watch => unreachable!("the log watch never ends"),
         };
         rig.finish().map_err(link::sim_failure)?;
-        report.map_err(Failure::from)
+        Ok((value, report?))
     });
     display.finish();
     result
 }
+
+/// The computation's stack: as large as the main thread's (8 MiB on Linux), where it ran
+/// before it had a thread of its own.
+const COMPUTE_STACK_BYTES: usize = 8 << 20;
 
 /// How often a simulated bus's log is checked for write errors.
 const LOG_CHECK: Duration = Duration::from_millis(100);

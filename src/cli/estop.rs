@@ -3,15 +3,21 @@
 //! `EMERGENCY_STOP` until a FaultReset (the next `dressform drive` sends one, as does
 //! `dressform reset`).
 //!
-//! When a dressform process owns the link (a `drive`, `run`, `status` or `reset` from another
-//! terminal), the stop goes through that process's control endpoint and its own thread sends
-//! it at once; otherwise this process opens the link and sends it.
+//! When a dressform process owns the link (a `drive`, `run`, `demo`, `status` or `reset` from
+//! another terminal), the stop goes through that process's control endpoint and its own thread
+//! sends it at once. Otherwise — no owner, an owner that does not answer or that belongs to
+//! another user — this process sends it on the link: opened as usual, or, when another
+//! process holds the device, written beside it without a lock (see
+//! [`shared_stop_gate`]). A stop is never refused.
 
 use super::Failure;
 use super::link::{self, FormArg, LinkArgs, runtime};
 use dressform::controller::open::OpenLink;
 use dressform::controller::simulated::SimConfig;
-use dressform::controller::{Connection, LinkSpec, control, emergency_stop, fault_names};
+use dressform::controller::transport::shared_stop_gate;
+use dressform::controller::{
+    Connection, LinkSpec, StopCause, control, emergency_stop, fault_names,
+};
 use std::time::Duration;
 
 #[derive(Debug, clap::Args)]
@@ -32,18 +38,41 @@ pub fn run(args: &EstopArgs) -> Result<(), Failure> {
     if spec == LinkSpec::Sim {
         return on_sim(args);
     }
-    if let Some(pid) = control::request_estop(&spec).map_err(Failure::other)? {
-        errln!("emergency stop sent by the dressform process {pid}, which owns the link");
-        return Ok(());
+    match control::request_estop(&spec) {
+        Ok(Some(owner)) if owner.trusted() => {
+            errln!(
+                "emergency stop sent by the dressform process {}, which owns the link",
+                owner.pid
+            );
+            return Ok(());
+        }
+        Ok(Some(owner)) => errln!(
+            "warning: the process answering for this link (pid {}) belongs to another user \
+             (uid {}): sending the stop on the link too",
+            owner.pid,
+            owner.uid
+        ),
+        Ok(None) => {}
+        Err(e) => errln!("warning: {e}: sending the stop on the link itself"),
     }
-    let connection = Connection::open(&spec).map_err(|e| {
-        Failure::other(format!(
-            "{e} (no dressform process owns it; if another program holds the port, stop it \
-             there)"
-        ))
-    })?;
-    emergency_stop(&connection).map_err(Failure::other)?;
-    errln!("emergency stop sent");
+    // No owner answered: the link itself, opened as usual when nobody holds it, else beside
+    // whoever does (a stop is never refused for want of a lock).
+    match Connection::open(&spec) {
+        Ok(connection) => {
+            emergency_stop(&connection).map_err(Failure::other)?;
+            errln!("emergency stop sent");
+        }
+        Err(busy) => {
+            let gate = shared_stop_gate(&spec).map_err(|e| {
+                Failure::other(format!(
+                    "{busy}; writing beside the process that holds it failed too: {e} (stop the \
+                     form there)"
+                ))
+            })?;
+            gate.emergency_stop(StopCause::Requested).map_err(Failure::other)?;
+            errln!("emergency stop sent on the link, beside the process that holds it ({busy})");
+        }
+    }
     Ok(())
 }
 

@@ -54,20 +54,26 @@ pub struct RunArgs {
 pub fn run(args: &RunArgs) -> Result<(), Failure> {
     let form = args.form.load()?;
     let girth_tolerance = args.shape.girth_tolerance()?;
-    let model = super::model::load(args.model.as_deref())?;
-    let pose = super::reconstruct::pose_overrides(args.pose.as_deref(), &model)?;
-    let mut scan = scan::load(&args.scan, &args.frame.options()).map_err(Failure::bad_input)?;
-    let file = scan.source.display().to_string();
-    for w in scan.cleaning.warnings().into_iter().chain(topology(&scan.body).warnings()) {
-        warn(&file, &w);
-    }
-    scan.body.taubin_smooth(args.smooth.smooth);
     let link = args.link.spec();
     let drive =
         Drive { link: &link, sim: &args.sim, options: &args.shape.options(), girth_tolerance };
-    let options = ReconstructOptions { pose, ..Default::default() };
-    let reconstruct = Reconstruct { model: &model, options: &options };
-    let (_, shape) = shape_form(&scan, &reconstruct, &form, &drive, &args.out, OutputSet::new())?;
+    // Read and checked once the form is claimed (see `shape_form`): nothing here moves it.
+    let (scan_path, frame, smooth) = (args.scan.clone(), args.frame.options(), args.smooth.smooth);
+    let (model_path, pose_path) = (args.model.clone(), args.pose.clone());
+    let prepare = move || {
+        let model = super::model::load(model_path.as_deref())?;
+        let pose = super::reconstruct::pose_overrides(pose_path.as_deref(), &model)?;
+        let mut scan = scan::load(&scan_path, &frame).map_err(Failure::bad_input)?;
+        let file = scan.source.display().to_string();
+        for w in scan.cleaning.warnings().into_iter().chain(topology(&scan.body).warnings()) {
+            warn(&file, &w);
+        }
+        scan.body.taubin_smooth(smooth);
+        let options = ReconstructOptions { pose, ..Default::default() };
+        let reconstruct = Reconstruct { model, options };
+        Ok(Prepared { scan, reconstruct, outputs: OutputSet::new(), extra: () })
+    };
+    let (_, shape, ()) = shape_form(&form, &drive, &args.out, prepare)?;
     shape_verdict(&shape)
 }
 
@@ -84,28 +90,83 @@ pub struct Drive<'a> {
 }
 
 /// How `run` and `demo` make the pose-symmetric scan.
-pub struct Reconstruct<'a> {
+pub struct Reconstruct {
     /// The body model.
-    pub model: &'a BodyModel,
+    pub model: BodyModel,
     /// The fit, the symmetric pose's overrides, the mannequin's options.
-    pub options: &'a ReconstructOptions,
+    pub options: ReconstructOptions,
 }
 
-/// The chain shared by `run` and `demo`: pose symmetry, mannequin, set-points, drive, report.
-/// The outputs are committed into `out` with the files already in `outputs`, as one set.
-/// Returns the reconstruction, and how well the form took the shape (the caller exits 3 when
-/// it did not). A fit that does not match the scan is an error (exit 2), never a mannequin.
-pub fn shape_form(
-    scan: &Scan,
-    reconstruct: &Reconstruct,
+/// What `run` and `demo` prepare before the reconstruction: the scan, how to reconstruct it,
+/// the output files made on the way, and anything else the caller wants back (`extra`).
+pub struct Prepared<X> {
+    /// The scan, in the canonical frame and smoothed.
+    pub scan: Scan,
+    /// The body model and options.
+    pub reconstruct: Reconstruct,
+    /// Files to commit with the reconstruction's, as one set.
+    pub outputs: OutputSet,
+    /// The caller's own.
+    pub extra: X,
+}
+
+/// The chain shared by `run` and `demo`: the form claimed first (its endpoint and signals
+/// armed, the e-stops latched on it recorded; see `execute`), then — while the link is kept
+/// alive — `prepare` (reading or making the scan), pose symmetry, mannequin and set-points
+/// on a thread of their own, the outputs committed into `out` as one set; then the drive and
+/// the report. An e-stop at any point ends the command (exit 1). Returns the reconstruction,
+/// how well the form took the shape (the caller exits 3 when it did not) and `prepare`'s
+/// extra. A fit that does not match the scan is an error (exit 2), never a mannequin.
+pub fn shape_form<X: Send + 'static>(
     form: &FormDescription,
     drive: &Drive,
     out: &Path,
+    prepare: impl FnOnce() -> Result<Prepared<X>, Failure> + Send + 'static,
+) -> Result<(Reshaped, ShapeOutcome, X), Failure> {
+    let (shape_of, out_dir) = (form.clone(), out.to_path_buf());
+    let compute = move || {
+        let Prepared { scan, reconstruct, outputs, extra } = prepare()?;
+        let done = reconstruct_and_write(&scan, &reconstruct, &shape_of, &out_dir, outputs)?;
+        let setpoints = done.shaped.setpoints.clone();
+        Ok(((done, extra), setpoints))
+    };
+    let ((done, extra), report) =
+        execute(form, drive.link, drive.options, drive.sim, false, compute)?;
+    for warning in &report.warnings {
+        errln!("warning: {warning}");
+    }
+    let setpoints = &done.shaped.setpoints;
+    let shape =
+        compare(form, &report.positions_mm, &setpoints.target_girths_mm, drive.girth_tolerance);
+    outln!(
+        "{} on {}: {} actuators moved together in {} ms; {}.",
+        report.form,
+        report.device,
+        report.actuators.len(),
+        report.duration_ms,
+        if shape.summary().is_some() {
+            "every actuator reached its set-point, but the form could NOT take the shape"
+        } else {
+            "every actuator reached its set-point and every ring the mannequin's girth"
+        }
+    );
+    outln!();
+    out!("{}", girth_table(&done, &shape));
+    Ok((done, shape, extra))
+}
+
+/// Pose symmetry, mannequin and set-points of `scan`, committed into `out` with the files
+/// already in `outputs` as one set, and the fit and the form's fit printed.
+fn reconstruct_and_write(
+    scan: &Scan,
+    reconstruct: &Reconstruct,
+    form: &FormDescription,
+    out: &Path,
     mut outputs: OutputSet,
-) -> Result<(Reshaped, ShapeOutcome), Failure> {
+) -> Result<Reshaped, Failure> {
     let file = scan.source.display().to_string();
     let bar = progress_bar(false, (STEPS.len() + SHAPE_STEPS.len()) as u64);
-    let done = reconstruct_shape(scan, reconstruct.model, reconstruct.options, form, |step| {
+    let done = reconstruct_shape(scan, &reconstruct.model, &reconstruct.options, form, |step| {
         bar.inc(1);
         bar.set_message(STEPS.iter().chain(&SHAPE_STEPS).nth(step).copied().unwrap_or(""));
     })
@@ -133,28 +194,7 @@ pub fn shape_form(
     outln!("Fit of form \"{}\" (ring heights on the form and on the body):", form.name);
     out!("{}", fidelity_table(&shaped.fit));
     outln!();
-    let setpoints = &shaped.setpoints;
-    let report = execute(form, setpoints, drive.link, drive.options, drive.sim, false)?;
-    for warning in &report.warnings {
-        errln!("warning: {warning}");
-    }
-    let shape =
-        compare(form, &report.positions_mm, &setpoints.target_girths_mm, drive.girth_tolerance);
-    outln!(
-        "{} on {}: {} actuators moved together in {} ms; {}.",
-        report.form,
-        report.device,
-        report.actuators.len(),
-        report.duration_ms,
-        if shape.summary().is_some() {
-            "every actuator reached its set-point, but the form could NOT take the shape"
-        } else {
-            "every actuator reached its set-point and every ring the mannequin's girth"
-        }
-    );
-    outln!();
-    out!("{}", girth_table(&done, &shape));
-    Ok((done, shape))
+    Ok(done)
 }
 
 /// Scan, pose-symmetric scan, mannequin and form girths at every ring: the scan's section

@@ -2,23 +2,38 @@
 //!
 //! On a real adapter only one process can open the port, so an e-stop from another terminal
 //! cannot use the link itself while a `drive` holds it. Every dressform process that owns a
-//! link (`drive`, `run`, `status`, `reset`) therefore listens on a Unix socket named after the
-//! device ([`Endpoint`]), in a directory only its user can enter: `$XDG_RUNTIME_DIR/dressform/`,
-//! else `<temp dir>/dressform-<uid>/` (mode 0700, checked to be the user's own; the socket is
-//! 0600). A client ([`request_estop`]) sends `estop`; the endpoint's own thread — not the
-//! owner's runtime, which may be busy — calls [`Gate::emergency_stop`] and answers `stopped
-//! <pid>` once the frames are out (or `failed <why>`). The owner's session then ends with
-//! "stopped by an e-stop from another terminal".
+//! link (`drive`, `run`, `demo`, `status`, `reset`) therefore listens on a local socket named
+//! after the device ([`Endpoint`]); a client ([`request_estop`]) sends `estop`, and a thread
+//! of the endpoint's — not the owner's runtime, which may be busy — calls
+//! [`Gate::emergency_stop`] and answers `stopped <pid>` once the frames are out (or
+//! `failed <why>`). The owner's session then ends with "stopped by an e-stop from another
+//! terminal".
 //!
-//! One endpoint per device: binding where a live endpoint answers is refused (two owners of
-//! one link is a mistake even on a pseudo-terminal that allows it); a socket left by a
-//! process that died is replaced. Symbolic links (`/dev/serial/by-id/...`) resolve to the
-//! device they name, so every spelling of one device reaches the same owner.
+//! **Where it is.** A Linux *abstract* Unix socket (no file; it vanishes with its process)
+//! named after the device's canonical path: `dressform/estop/tty/dev/pts/5`,
+//! `dressform/estop/can/can0` (a long path is shortened with a hash, [`socket_name`]). The
+//! name depends on nothing but the device: not on `XDG_RUNTIME_DIR`, `TMPDIR` or a folder
+//! another user may have made, and no socket is ever left behind by a process that died.
+//! Symbolic links (`/dev/serial/by-id/...`) resolve to the device they name, so every
+//! spelling of one device reaches the same owner. Abstract sockets are per network
+//! namespace: a process in another one (a container) does not see the endpoint, and
+//! `estop` then sends the stop on the link itself.
+//!
+//! **Who answers.** Anyone may ask for a stop (a stop is never refused). The client checks
+//! who answered (the socket's peer credentials, [`Owner`]): an answer from a process of
+//! another user (not root) could come from a process squatting the name, so `estop` then
+//! also sends the stop on the link itself.
+//!
+//! **Never held up.** The endpoint accepts in a loop and answers every client on a thread of
+//! its own, so silent or slow clients cannot delay another client's stop.
+//!
+//! One endpoint per device: binding where one is bound is refused (two owners of one link is
+//! a mistake even on a pseudo-terminal that allows it).
 
 use std::io::{self, BufRead, BufReader, Read, Write};
-use std::os::unix::fs::{DirBuilderExt, MetadataExt, PermissionsExt};
-use std::os::unix::net::{UnixListener, UnixStream};
-use std::path::{Path, PathBuf};
+use std::os::fd::AsRawFd;
+use std::os::linux::net::SocketAddrExt;
+use std::os::unix::net::{SocketAddr, UnixListener, UnixStream};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
@@ -36,36 +51,37 @@ const MAX_LINE: u64 = 256;
 /// The request.
 const ESTOP: &str = "estop";
 
-/// How much of a device's name goes into its endpoint's name (a Unix socket's path is at
-/// most 107 bytes; the hash keeps names unique).
-const MAX_NAME_CHARS: usize = 24;
+/// Every endpoint's name starts so.
+const PREFIX: &str = "dressform/estop/";
+
+/// The longest abstract socket name (a socket address holds 108 bytes, the first of an
+/// abstract name is its leading NUL).
+const MAX_NAME_BYTES: usize = 107;
+
+/// How much of a long device path is kept beside its hash.
+const KEPT_PATH_CHARS: usize = 40;
+
+/// The stack of a thread answering one client: it reads a line and writes one.
+const ANSWER_STACK_BYTES: usize = 64 * 1024;
 
 /// Why the endpoint could not be used.
 #[derive(Debug, thiserror::Error)]
 pub enum ControlError {
-    /// The directory or socket could not be made or used.
-    #[error("control endpoint {}: {source}", path.display())]
+    /// The socket could not be made or used.
+    #[error("control endpoint of {device}: {source}")]
     Io {
-        /// The directory or socket.
-        path: PathBuf,
+        /// The device.
+        device: String,
         /// What the operating system said.
         source: io::Error,
     },
-    /// The directory is not private to this user (someone else could intercept an e-stop).
-    #[error("control endpoint {}: {problem}; remove it or set XDG_RUNTIME_DIR", path.display())]
-    Unsafe {
-        /// The directory.
-        path: PathBuf,
-        /// What is wrong with it.
-        problem: String,
-    },
     /// A live process already owns the link.
-    #[error("{device}: another dressform process owns this link (its control endpoint {} answers)", path.display())]
+    #[error("{device}: another process (pid {pid}) owns this link: its control endpoint answers")]
     Owned {
         /// The device.
         device: String,
-        /// Its endpoint.
-        path: PathBuf,
+        /// The owner's process id (0 when the system did not say).
+        pid: u32,
     },
     /// The owner answered that it could not stop the form, or did not answer in time.
     #[error("{device}: the dressform process that owns this link {problem}")]
@@ -77,31 +93,21 @@ pub enum ControlError {
     },
 }
 
-/// The directory of the control endpoints: private to this user.
-pub fn directory() -> Result<PathBuf, ControlError> {
-    let dir = match std::env::var_os("XDG_RUNTIME_DIR").map(PathBuf::from) {
-        Some(runtime) if runtime.is_dir() => runtime.join("dressform"),
-        _ => std::env::temp_dir().join(format!("dressform-{}", uid())),
-    };
-    let io = |source| ControlError::Io { path: dir.clone(), source };
-    match std::fs::DirBuilder::new().mode(0o700).create(&dir) {
-        Ok(()) => {}
-        Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {}
-        Err(e) => return Err(io(e)),
+/// The process that answered an e-stop request.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Owner {
+    /// Its process id.
+    pub pid: u32,
+    /// Its user id.
+    pub uid: u32,
+}
+
+impl Owner {
+    /// Whether its answer can be believed: a process of this user or of root. Another user's
+    /// process may have taken the device's name without owning the device.
+    pub fn trusted(&self) -> bool {
+        self.uid == uid() || self.uid == 0
     }
-    let meta = std::fs::symlink_metadata(&dir).map_err(io)?;
-    let unsafe_dir =
-        |problem: &str| ControlError::Unsafe { path: dir.clone(), problem: problem.into() };
-    if !meta.is_dir() {
-        return Err(unsafe_dir("not a directory"));
-    }
-    if meta.uid() != uid() {
-        return Err(unsafe_dir("owned by another user"));
-    }
-    if meta.permissions().mode() & 0o077 != 0 {
-        return Err(unsafe_dir("open to other users (it must be mode 0700)"));
-    }
-    Ok(dir)
 }
 
 fn uid() -> u32 {
@@ -109,8 +115,9 @@ fn uid() -> u32 {
     unsafe { libc::getuid() }
 }
 
-/// The endpoint's file name for a link: the device's last path component (after resolving
-/// symbolic links) and a hash of its full path; `None` for the in-process simulated form,
+/// The endpoint's abstract socket name for a link: [`PREFIX`], the link's kind and the
+/// device's canonical path (symbolic links resolved); a path too long for a socket name keeps
+/// its last characters beside a hash of the whole. `None` for the in-process simulated form,
 /// which no other process can reach.
 pub fn socket_name(spec: &LinkSpec) -> Option<String> {
     let (kind, name) = match spec {
@@ -121,13 +128,13 @@ pub fn socket_name(spec: &LinkSpec) -> Option<String> {
         }
         LinkSpec::Can(interface) => ("can", interface.clone()),
     };
-    let last = name.rsplit('/').next().unwrap_or(&name);
-    let last: String = last
-        .chars()
-        .take(MAX_NAME_CHARS)
-        .map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' })
-        .collect();
-    Some(format!("{kind}-{last}-{:016x}.sock", fnv1a(name.as_bytes())))
+    let whole = format!("{PREFIX}{kind}{name}");
+    if whole.len() <= MAX_NAME_BYTES {
+        return Some(whole);
+    }
+    let chars: Vec<char> = name.chars().collect();
+    let tail: String = chars[chars.len().saturating_sub(KEPT_PATH_CHARS)..].iter().collect();
+    Some(format!("{PREFIX}{kind}#{:016x}…{tail}", fnv1a(name.as_bytes())))
 }
 
 /// FNV-1a, 64 bits: a hash that stays the same across Rust versions (std's does not
@@ -136,6 +143,31 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     const OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
     const PRIME: u64 = 0x0100_0000_01b3;
     bytes.iter().fold(OFFSET, |h, &b| (h ^ u64::from(b)).wrapping_mul(PRIME))
+}
+
+fn address(name: &str) -> io::Result<SocketAddr> {
+    SocketAddr::from_abstract_name(name.as_bytes())
+}
+
+/// The process at the other end of a Unix socket.
+fn peer(stream: &UnixStream) -> io::Result<Owner> {
+    let mut cred = libc::ucred { pid: 0, uid: 0, gid: 0 };
+    let mut len = std::mem::size_of::<libc::ucred>() as libc::socklen_t;
+    // SAFETY: `cred` and `len` are valid for writes and `len` holds `cred`'s size, as
+    // getsockopt(SO_PEERCRED) requires; the descriptor is a Unix socket owned by `stream`.
+    let status = unsafe {
+        libc::getsockopt(
+            stream.as_raw_fd(),
+            libc::SOL_SOCKET,
+            libc::SO_PEERCRED,
+            (&raw mut cred).cast(),
+            &raw mut len,
+        )
+    };
+    if status != 0 {
+        return Err(io::Error::last_os_error());
+    }
+    Ok(Owner { pid: u32::try_from(cred.pid).unwrap_or_default(), uid: cred.uid })
 }
 
 /// The link's gate once it is open; until then, whether an e-stop came meanwhile (it is sent
@@ -148,11 +180,11 @@ enum Slot {
     Open(Gate),
 }
 
-/// The endpoint of the process that owns a link, answering e-stops on a thread of its own.
-/// Dropping it closes and removes the socket.
+/// The endpoint of the process that owns a link, answering e-stops on threads of its own.
+/// Dropping it closes the socket.
 #[derive(Debug)]
 pub struct Endpoint {
-    path: PathBuf,
+    name: String,
     gate: Arc<Mutex<Slot>>,
     closing: Arc<AtomicBool>,
     thread: Option<std::thread::JoinHandle<()>>,
@@ -164,18 +196,17 @@ impl Endpoint {
     /// `None` for the simulated form.
     pub fn bind(spec: &LinkSpec) -> Result<Option<Self>, ControlError> {
         let Some(name) = socket_name(spec) else { return Ok(None) };
-        let path = directory()?.join(name);
-        let io = |source| ControlError::Io { path: path.clone(), source };
-        if UnixStream::connect(&path).is_ok() {
-            return Err(ControlError::Owned { device: device_name(spec), path });
-        }
-        match std::fs::remove_file(&path) {
-            Ok(()) => {}
-            Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+        let io = |source| ControlError::Io { device: device_name(spec), source };
+        let listener = match UnixListener::bind_addr(&address(&name).map_err(io)?) {
+            Ok(listener) => listener,
+            Err(e) if e.kind() == io::ErrorKind::AddrInUse => {
+                let pid = UnixStream::connect_addr(&address(&name).map_err(io)?)
+                    .and_then(|s| peer(&s))
+                    .map_or(0, |owner| owner.pid);
+                return Err(ControlError::Owned { device: device_name(spec), pid });
+            }
             Err(e) => return Err(io(e)),
-        }
-        let listener = UnixListener::bind(&path).map_err(io)?;
-        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600)).map_err(io)?;
+        };
         let gate: Arc<Mutex<Slot>> = Arc::default();
         let closing = Arc::new(AtomicBool::new(false));
         let thread = {
@@ -185,7 +216,7 @@ impl Endpoint {
                 .spawn(move || listen(&listener, &gate, &closing))
                 .map_err(io)?
         };
-        Ok(Some(Self { path, gate, closing, thread: Some(thread) }))
+        Ok(Some(Self { name, gate, closing, thread: Some(thread) }))
     }
 
     /// From now on, e-stops go to `gate`; one that came while the link was opening is sent
@@ -197,9 +228,9 @@ impl Endpoint {
         if pending { gate.emergency_stop(StopCause::Remote) } else { Ok(()) }
     }
 
-    /// The socket's path.
-    pub fn path(&self) -> &Path {
-        &self.path
+    /// The socket's abstract name.
+    pub fn name(&self) -> &str {
+        &self.name
     }
 }
 
@@ -207,24 +238,32 @@ impl Drop for Endpoint {
     fn drop(&mut self) {
         self.closing.store(true, Ordering::SeqCst);
         // Wake the accepting thread so it sees `closing`.
-        let _ = UnixStream::connect(&self.path);
+        if let Ok(address) = address(&self.name) {
+            let _ = UnixStream::connect_addr(&address);
+        }
         if let Some(thread) = self.thread.take() {
             let _ = thread.join();
         }
-        let _ = std::fs::remove_file(&self.path);
     }
 }
 
-/// Answers requests until `closing`.
-fn listen(listener: &UnixListener, gate: &Mutex<Slot>, closing: &AtomicBool) {
+/// Accepts clients until `closing`, each answered on a thread of its own.
+fn listen(listener: &UnixListener, gate: &Arc<Mutex<Slot>>, closing: &AtomicBool) {
     for stream in listener.incoming() {
         if closing.load(Ordering::SeqCst) {
             return;
         }
         // A client that fails mid-request loses its answer; the endpoint goes on.
-        if let Ok(stream) = stream {
-            let _ = answer(stream, gate);
-        }
+        let Ok(stream) = stream else { continue };
+        let gate = Arc::clone(gate);
+        let answering = std::thread::Builder::new()
+            .name("dressform control client".into())
+            .stack_size(ANSWER_STACK_BYTES)
+            .spawn(move || {
+                let _ = answer(stream, &gate);
+            });
+        // Out of threads: that client gets no answer (it then sends the stop on the link).
+        drop(answering);
     }
 }
 
@@ -262,14 +301,16 @@ fn device_name(spec: &LinkSpec) -> String {
     }
 }
 
-/// Asks the process that owns `spec`'s link to e-stop it. `Ok(Some(pid))`: the owner (that
-/// process) sent the emergency stop; `Ok(None)`: no process owns the link through an
-/// endpoint (use the link directly).
-pub fn request_estop(spec: &LinkSpec) -> Result<Option<u32>, ControlError> {
+/// Asks the process that owns `spec`'s link to e-stop it. `Ok(Some(owner))`: that process
+/// answered that it sent the emergency stop (check [`Owner::trusted`]); `Ok(None)`: no
+/// process owns the link through an endpoint (use the link directly).
+pub fn request_estop(spec: &LinkSpec) -> Result<Option<Owner>, ControlError> {
     let Some(name) = socket_name(spec) else { return Ok(None) };
-    let path = directory()?.join(name);
-    let Ok(stream) = UnixStream::connect(&path) else { return Ok(None) };
+    let device = device_name(spec);
+    let address = address(&name).map_err(|source| ControlError::Io { device, source })?;
+    let Ok(stream) = UnixStream::connect_addr(&address) else { return Ok(None) };
     let failed = |problem: String| ControlError::Failed { device: device_name(spec), problem };
+    let owner = peer(&stream).map_err(|e| failed(format!("cannot be identified: {e}")))?;
     let talk = || -> io::Result<String> {
         stream.set_read_timeout(Some(REPLY_TIMEOUT))?;
         stream.set_write_timeout(Some(REPLY_TIMEOUT))?;
@@ -278,17 +319,20 @@ pub fn request_estop(spec: &LinkSpec) -> Result<Option<u32>, ControlError> {
         BufReader::new((&stream).take(MAX_LINE)).read_line(&mut line)?;
         Ok(line.trim().to_string())
     };
-    let reply = talk().map_err(|e| failed(format!("did not answer: {e}")))?;
+    let reply = talk().map_err(|e| failed(format!("(pid {}) did not answer: {e}", owner.pid)))?;
     match reply.strip_prefix("stopped ") {
-        Some(pid) => Ok(Some(pid.parse().unwrap_or_default())),
-        None if reply.is_empty() => Err(failed("closed the connection without an answer".into())),
-        None => Err(failed(reply)),
+        Some(_) => Ok(Some(owner)),
+        None if reply.is_empty() => {
+            Err(failed(format!("(pid {}) closed the connection without an answer", owner.pid)))
+        }
+        None => Err(failed(format!("(pid {}) {reply}", owner.pid))),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::PathBuf;
 
     #[test]
     fn every_spelling_of_a_device_names_one_endpoint() {
@@ -298,14 +342,40 @@ mod tests {
         let alias = dir.path().join("usb-FTDI_FT232R-if00-port0");
         std::os::unix::fs::symlink(&device, &alias).unwrap();
         let name = socket_name(&LinkSpec::Serial(device.clone())).unwrap();
-        assert!(name.starts_with("tty-ttyUSB0-") && name.ends_with(".sock"), "{name}");
+        assert!(name.starts_with("dressform/estop/tty/") && name.ends_with("/ttyUSB0"), "{name}");
         assert_eq!(socket_name(&LinkSpec::Slcan(alias)), Some(name.clone()));
         let other = socket_name(&LinkSpec::Serial(dir.path().join("ttyUSB1"))).unwrap();
         assert_ne!(other, name);
-        assert!(socket_name(&LinkSpec::Can("can0".into())).unwrap().starts_with("can-can0-"));
+        assert_eq!(socket_name(&LinkSpec::Can("can0".into())).unwrap(), "dressform/estop/cancan0");
         assert_eq!(socket_name(&LinkSpec::Sim), None);
-        // Unix socket paths are limited to 107 bytes: names stay short.
-        let long = LinkSpec::Serial(PathBuf::from(format!("/dev/{}", "x".repeat(300))));
-        assert!(socket_name(&long).unwrap().len() <= 4 + MAX_NAME_CHARS + 1 + 16 + 5);
+        // Socket names are limited to 107 bytes: long paths are shortened, still unique.
+        let long = |c: &str| LinkSpec::Serial(PathBuf::from(format!("/dev/{}", c.repeat(300))));
+        let (x, y) = (socket_name(&long("x")).unwrap(), socket_name(&long("y")).unwrap());
+        assert!(x.len() <= MAX_NAME_BYTES && y.len() <= MAX_NAME_BYTES, "{x}");
+        assert_ne!(x, y);
+    }
+
+    #[test]
+    fn silent_clients_do_not_hold_up_a_stop() {
+        let spec = LinkSpec::Can(format!("test-silent-{}", std::process::id()));
+        let endpoint = Endpoint::bind(&spec).unwrap().unwrap();
+        let address = address(endpoint.name()).unwrap();
+        // Five clients that connect and say nothing.
+        let silent: Vec<UnixStream> =
+            (0..5).map(|_| UnixStream::connect_addr(&address).unwrap()).collect();
+        let start = std::time::Instant::now();
+        let owner = request_estop(&spec).unwrap().unwrap();
+        // Far below the 1 s a client may take to speak (the old one-at-a-time endpoint waited
+        // that long for each silent client before it read this request).
+        assert!(start.elapsed() < REPLY_TIMEOUT / 2, "{:?}", start.elapsed());
+        assert_eq!(owner.pid, std::process::id());
+        assert!(owner.trusted());
+        drop(silent);
+        // A second owner of the same link is refused while the first lives.
+        let refused = Endpoint::bind(&spec).unwrap_err();
+        assert!(refused.to_string().contains("owns this link"), "{refused}");
+        drop(endpoint);
+        assert!(request_estop(&spec).unwrap().is_none());
+        assert!(Endpoint::bind(&spec).unwrap().is_some());
     }
 }

@@ -9,6 +9,7 @@
 //! | module | what it holds |
 //! |---|---|
 //! | [`transport`] | the [`Transport`] trait; serial, slcan, SocketCAN and simulated links; the [`Gate`] every packet goes through, and the e-stop on it from any thread (`transport::gate`) |
+//! | [`claim`] | the form claimed for a whole command: e-stops latched at its start recorded, the link kept alive while it computes, no later e-stop cleared |
 //! | [`control`] | the local control endpoint: `dressform estop` reaching the link's owner |
 //! | [`session`] | discovery, fault reset, enable/home, heartbeats and polls, liveness, faults, reboots |
 //! | [`motion`] | staging, the common SYNC duration, watching feedback, the report |
@@ -24,6 +25,7 @@
 //! and broadcasts `EmergencyStop` without waiting for the session; a hardware fault is never
 //! cleared without the caller's say-so.
 
+pub mod claim;
 pub mod control;
 pub mod faults;
 pub mod motion;
@@ -42,6 +44,7 @@ use serde::Serialize;
 use tokio::time::Instant;
 
 pub use crate::safety::SafeTarget;
+pub use claim::Claim;
 pub use faults::{fault_names, state_name};
 pub use motion::{ActuatorReport, MoveError, NodeProgress, PlannedTarget, Progress};
 pub use session::{Cleared, NodeProblem, Session, SessionError};
@@ -174,64 +177,20 @@ pub fn plan(
 }
 
 /// Drives the form to `setpoints`: checks them (refusing or clamping out-of-stroke
-/// positions before anything is sent), discovers and checks every node, clears latched
-/// faults as [`DriveOptions::reset_faults`] allows, enables and homes, moves every actuator
-/// together, watches until all are within tolerance, then disables. `progress` is called
-/// about every 50 ms during the move.
+/// positions before anything is sent), claims the form ([`Claim::take`]: discovers and
+/// checks every node), then drives it ([`Claim::drive`]): clears latched faults as
+/// [`DriveOptions::reset_faults`] allows, enables and homes, moves every actuator together,
+/// watches until all are within tolerance, then disables. `progress` is called about every
+/// 50 ms during the move.
 pub async fn drive<T: Transport>(
     transport: T,
     form: &FormDescription,
     setpoints: &SetPoints,
     options: &DriveOptions,
-    mut progress: impl FnMut(&Progress),
+    progress: impl FnMut(&Progress),
 ) -> Result<DriveReport, DriveError> {
-    let (plan, clamped) = plan(form, setpoints, options.clamp)?;
-    let device = transport.device();
-    let mut session = Session::new(transport, form);
-    session.discover().await?;
-    let allowed = if options.reset_faults { ANY_FAULT } else { faults::CLEARED_AT_START };
-    let cleared = session.reset_faults(allowed).await?;
-    let remaining: Vec<String> = cleared
-        .iter()
-        .filter(|c| !c.remaining.is_empty())
-        .map(|c| format!("{}: {}", c.node, faults::describe(c.remaining)))
-        .collect();
-    if !remaining.is_empty() {
-        return Err(SessionError::NotCleared(remaining).into());
-    }
-    let mut notes = cleared_notes(&cleared);
-    session.enable_all(options.homing_timeout).await?;
-    let move_options = motion::MoveOptions {
-        tolerance_mm: options.tolerance_mm,
-        slower: options.slower,
-        min_duration: options.min_duration,
-        settle: options.settle,
-    };
-    let started = Instant::now();
-    let result =
-        motion::run(&mut session, &plan, &move_options, options.homing_timeout, &mut progress)
-            .await;
-    let (duration_ms, actuators, warnings) = match result {
-        Ok(done) => done,
-        // A session error is the session's, wherever it happened.
-        Err(MoveError::Session(e)) => return Err(e.into()),
-        Err(e) => return Err(e.into()),
-    };
-    notes.extend(warnings);
-    let elapsed_ms = started.elapsed().as_millis() as u64;
-    let positions_mm = positions_of(&session);
-    session.disable_all().await?;
-    let report = DriveReport {
-        form: form.name.clone(),
-        device,
-        duration_ms,
-        elapsed_ms,
-        actuators,
-        positions_mm,
-        clamped,
-        warnings: notes,
-    };
-    if report.converged() { Ok(report) } else { Err(DriveError::NotReached(Box::new(report))) }
+    plan(form, setpoints, options.clamp)?;
+    Claim::take(transport, form).await?.drive(setpoints, options, progress).await
 }
 
 /// One note per kind of fault cleared: `cleared the latched emergency stop on nodes 1, 2, 3`.
@@ -355,7 +314,7 @@ pub async fn reset<T: Transport>(
     for node in nodes {
         problems.extend(session.identify(node).await?);
     }
-    let cleared = session.reset_faults(ANY_FAULT).await?;
+    let cleared = session.reset_faults(|_| ANY_FAULT).await?;
     Ok(ResetReport { problems, cleared })
 }
 

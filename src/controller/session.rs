@@ -119,6 +119,9 @@ pub struct NodeStatus {
     pub heartbeat: Option<Heartbeat>,
     /// When its last heartbeat came.
     pub heartbeat_at: Option<Instant>,
+    /// The faults latched in the first heartbeat heard from it in this session: what it held
+    /// before the host could have done anything (see [`super::claim`]).
+    pub first_faults: Option<Faults>,
     /// Its actuators' last reported positions (`None`: unknown).
     pub positions: [Option<Position>; MAX_ACTUATORS],
     /// When it was last heard from, in the session's listening time.
@@ -228,6 +231,10 @@ pub enum SessionError {
     /// A FaultReset did not clear a node's faults (their cause remains).
     #[error("faults not cleared (their cause remains):\n  {}", .0.join("\n  "))]
     NotCleared(Vec<String>),
+    /// An e-stop latched on these nodes after the command claimed the form (see
+    /// [`super::claim`]): the command ends without clearing it.
+    #[error("stopped by an e-stop latched on {} after this command started (it is not cleared: check the form, then `dressform reset`)", .0.join(", "))]
+    StoppedSinceStart(Vec<String>),
     /// The link was e-stopped (another terminal, a signal): the session sent nothing more.
     #[error("stopped by {0}: emergency stop sent to every node")]
     Stopped(StopCause),
@@ -355,6 +362,11 @@ impl<T: Transport> Session<T> {
         &self.form
     }
 
+    /// The link's device name (`/dev/ttyUSB0`, `can0`, `simulated bus`).
+    pub fn device(&self) -> String {
+        self.transport.device()
+    }
+
     /// The link's kind.
     pub fn link(&self) -> Link {
         self.transport.link()
@@ -416,6 +428,7 @@ impl<T: Transport> Session<T> {
                 if h.state == DriveState::Disabled && (was_on || forgot_homes) {
                     status.rebooted = true;
                 }
+                status.first_faults.get_or_insert(h.faults);
                 status.heartbeat = Some(h);
                 status.heartbeat_at = Some(Instant::now());
             }
@@ -860,13 +873,16 @@ impl<T: Transport> Session<T> {
         Ok(())
     }
 
-    /// Clears the latched faults of every node within `allowed`: refuses (sending nothing)
+    /// Clears the latched faults of every node within `allowed(node)`: refuses (sending nothing)
     /// when a node holds another fault ([`SessionError::Latched`], naming the node, the
     /// actuators its events named, and the faults in words); otherwise sends FaultReset to
     /// every node in Fault, after a fresh host heartbeat (the node checks the host is alive
     /// before clearing a host timeout). Returns, per node that was in Fault, what it held and
     /// what remains. Events from before are consumed.
-    pub async fn reset_faults(&mut self, allowed: Faults) -> Result<Vec<Cleared>, SessionError> {
+    pub async fn reset_faults(
+        &mut self,
+        allowed: impl Fn(NodeId) -> Faults,
+    ) -> Result<Vec<Cleared>, SessionError> {
         self.refresh().await?;
         // Events still pending on a node (serial keeps them for the next poll) are old news
         // by now: take them for the actuators they name.
@@ -896,7 +912,7 @@ impl<T: Transport> Session<T> {
             .collect();
         let refused: Vec<String> = cleared
             .iter()
-            .filter(|c| !allowed.contains(c.faults))
+            .filter(|c| NodeId::new(c.node.address).is_none_or(|n| !allowed(n).contains(c.faults)))
             .map(ToString::to_string)
             .collect();
         if !refused.is_empty() {

@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use firmware_protocol::Packet;
-use serialport::{ClearBuffer, SerialPort};
+use serialport::ClearBuffer;
 use tokio::sync::mpsc;
 
 use super::TransportError;
@@ -90,7 +90,7 @@ impl Line {
             })
             .map_err(io)?;
         let line = Self { device: device.clone(), packets, stop, reader: Some(reader) };
-        Ok((line, Writer { device, port: writer }))
+        Ok((line, Writer { device, port: Box::new(writer) }))
     }
 
     /// The device path.
@@ -114,10 +114,27 @@ impl Line {
 /// The writing handle of an open serial device.
 pub struct Writer {
     device: String,
-    port: Box<dyn SerialPort>,
+    port: Box<dyn Write + Send>,
 }
 
 impl Writer {
+    /// Opens `path` for writing beside the process that holds it: no lock taken, none
+    /// respected (`flock`), and the terminal's settings left as its holder made them. Only
+    /// for an emergency stop whose holder cannot be reached (see
+    /// [`super::shared_stop_gate`]). A terminal another process marked exclusive
+    /// (`TIOCEXCL`) still refuses a user other than root.
+    pub fn shared(path: &Path) -> Result<Self, TransportError> {
+        use std::os::unix::fs::OpenOptionsExt;
+        let device = path.display().to_string();
+        let port = std::fs::OpenOptions::new()
+            .write(true)
+            // Non-blocking: a device that takes nothing fails the write rather than hang the stop.
+            .custom_flags(libc::O_NOCTTY | libc::O_NONBLOCK)
+            .open(path)
+            .map_err(|source| TransportError::Io { device: device.clone(), source })?;
+        Ok(Self { device, port: Box::new(port) })
+    }
+
     /// Writes `bytes` in full (each write waits at most [`READ_TIMEOUT`] for the device).
     pub fn write(&mut self, bytes: &[u8]) -> Result<(), TransportError> {
         self.port

@@ -127,6 +127,18 @@ impl Connection {
     }
 }
 
+/// A gate on `spec`'s link that needs no lock on it: for an emergency stop when the link is
+/// held by a process that cannot be reached (see [`super::control`]). Serial devices are
+/// written beside their holder ([`serial::shared_gate`], [`slcan::shared_gate`]); a SocketCAN
+/// interface takes any number of sockets, so it is opened as usual.
+pub fn shared_stop_gate(spec: &LinkSpec) -> Result<Gate, TransportError> {
+    match spec {
+        LinkSpec::Serial(path) => serial::shared_gate(path),
+        LinkSpec::Slcan(path) => slcan::shared_gate(path),
+        LinkSpec::Can(_) | LinkSpec::Sim => Connection::open(spec).map(|c| c.gate().clone()),
+    }
+}
+
 impl Transport for Connection {
     fn link(&self) -> Link {
         match self {

@@ -62,6 +62,16 @@ impl SerialLine {
     }
 }
 
+/// A gate that writes frames to `path` beside the process holding it ([`Writer::shared`]):
+/// the nodes' decoders resynchronise at the frame delimiter, so a frame of the holder's that
+/// the stop interrupts is lost, the stop itself is not (it is sent several times).
+pub fn shared_gate(path: &Path) -> Result<Gate, TransportError> {
+    let mut writer = Writer::shared(path)?;
+    // End whatever partial frame the holder may be writing.
+    writer.write(&[0])?;
+    Ok(Gate::new(path.display().to_string(), Numbered { writer, seq: 0, last: None }))
+}
+
 impl Transport for SerialLine {
     fn link(&self) -> Link {
         Link::Serial

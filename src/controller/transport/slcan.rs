@@ -71,6 +71,17 @@ impl Slcan {
     }
 }
 
+/// A gate that writes frame lines to the adapter at `path` beside the process holding it
+/// ([`Writer::shared`]; the adapter's channel is open, as its holder left it): a line of the
+/// holder's that the stop interrupts is lost at its `\r`, the stop itself is not (it is sent
+/// several times).
+pub fn shared_gate(path: &Path) -> Result<Gate, TransportError> {
+    let mut writer = Writer::shared(path)?;
+    // End whatever partial line the holder may be writing.
+    writer.write(b"\r")?;
+    Ok(Gate::new(path.display().to_string(), Lines(writer)))
+}
+
 /// The packet of a received line (`firmware_protocol::slcan`'s frame line, the timestamp
 /// ignored; a `z` acknowledgement may run into it), if it is a valid protocol frame.
 pub fn parse_line(line: &[u8]) -> Option<Packet> {
