@@ -349,3 +349,52 @@ fn estop_needs_no_shared_runtime_folder() {
         );
     }
 }
+
+/// Ctrl-C while `run` computes e-stops the form and ends it with status 1, as during a move
+/// (it used to end with the shell's 130 and no stop).
+#[test]
+fn ctrl_c_while_run_computes_stops_the_form_and_exits_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let scan = scan_file(dir.path());
+    let server = serve(ServeConfig::new(reference(), Transport::SerialPty)).unwrap();
+    let mut run = spawn_run(&server, Transport::SerialPty, &scan, &dir.path().join("out"));
+    let mut stderr = Stderr::of(&mut run);
+    stderr.wait_for(CLAIMED, CLAIM_TIMEOUT);
+    let pid = libc::pid_t::try_from(run.id()).unwrap();
+    // SAFETY: kill has no memory effects; `pid` is our child, not yet reaped.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGINT) }, 0);
+    wait_latched(&server);
+    let ran = run.wait_with_output().unwrap();
+    let ran = Output { stderr: stderr.rest().into_bytes(), ..ran };
+    assert_eq!(ran.status.code(), Some(1), "{}", text(&ran));
+    assert!(text(&ran).contains("stopped by Ctrl-C (SIGINT)"), "{}", text(&ran));
+}
+
+/// An owner that cannot answer (here stopped with SIGSTOP: hung, or descheduled for long):
+/// `estop` waits a moment for it, then sends the stop on the link itself, beside the process
+/// that holds the device, and says so; the form stops all the same.
+#[test]
+fn a_hung_owner_does_not_keep_the_stop_from_the_form() {
+    for transport in [Transport::SerialPty, Transport::SlcanPty] {
+        let server = serve(ServeConfig::new(reference(), transport)).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let drive = moving_drive(&server, transport, &far_setpoints(dir.path()));
+        let pid = libc::pid_t::try_from(drive.id()).unwrap();
+        // SAFETY: kill has no memory effects; `pid` is our child, not yet reaped.
+        assert_eq!(unsafe { libc::kill(pid, libc::SIGSTOP) }, 0);
+        let estop = Command::new(env!("CARGO_BIN_EXE_dressform"))
+            .args(["estop", flag(transport)])
+            .arg(server.device_path())
+            .output()
+            .unwrap();
+        // The e-stop flag is latched only by an EmergencyStop (a host timeout is another).
+        wait_latched(&server);
+        // SAFETY: as above.
+        assert_eq!(unsafe { libc::kill(pid, libc::SIGCONT) }, 0);
+        assert_eq!(estop.status.code(), Some(0), "{}", text(&estop));
+        assert!(text(&estop).contains("did not answer"), "{}", text(&estop));
+        assert!(text(&estop).contains("beside the process that holds it"), "{}", text(&estop));
+        let out = drive.wait_with_output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{}", text(&out));
+    }
+}

@@ -4,9 +4,11 @@
 //! A command that computes before it moves the form (`run`, `demo`: the body model's fit and
 //! the mannequin take seconds) must not undo an e-stop pressed meanwhile. So the command
 //! claims the form first ([`Claim::take`]): the link is open (its control endpoint answers,
-//! signals e-stop it), every node is discovered, and the e-stops latched on the nodes when the
-//! host first heard them are recorded (a node's first heartbeat of the session: a stop
-//! latched later, even during the discovery, is the command's to respect). While the command computes, [`Claim::hold_while`] keeps the
+//! signals e-stop it), every node is discovered, and the e-stops latched on the nodes then are
+//! recorded: from a heartbeat of every node heard after the discovery. (Not from the first
+//! heartbeat heard: on a loaded machine a pseudo-terminal can deliver a node's heartbeat from
+//! before an earlier command's stop after this command opened the link, and a stop latched
+//! before the claim ended is one the command could not have known of when it started.) While the command computes, [`Claim::hold_while`] keeps the
 //! link alive (host heartbeats, polls, liveness) and ends the command as soon as the link is
 //! e-stopped or an e-stop latches on a node that had none at the start (`dressform estop`
 //! falling back to the link itself, a stop button on the form). When the move starts
@@ -44,25 +46,14 @@ pub struct Claim<T> {
 
 impl<T: Transport> Claim<T> {
     /// Claims the form over `transport`: discovers every node and checks it against `form`,
-    /// waits for a heartbeat of each, and records which nodes held a latched e-stop in the
-    /// first heartbeat heard from them.
+    /// then records which nodes hold a latched e-stop (from a heartbeat of each heard after
+    /// the discovery).
     pub async fn take(transport: T, form: &FormDescription) -> Result<Self, SessionError> {
         let mut session = Session::new(transport, form);
         session.discover().await?;
         session.refresh().await?;
-        let stopped_at_start = session
-            .nodes()
-            .iter()
-            .filter(|(_, s)| s.first_faults.is_some_and(|f| f.contains(Faults::EMERGENCY_STOP)))
-            .map(|(&n, _)| n)
-            .collect();
-        let claim = Self { session, stopped_at_start };
-        // A stop latched since the first heartbeats (during the discovery) ends it now.
-        let late = newly_stopped(&claim.session, &claim.stopped_at_start);
-        if !late.is_empty() {
-            return Err(SessionError::StoppedSinceStart(names(&claim.session, &late)));
-        }
-        Ok(claim)
+        let stopped_at_start = estopped(&session);
+        Ok(Self { session, stopped_at_start })
     }
 
     /// The nodes that held a latched e-stop when the form was claimed.

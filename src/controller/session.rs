@@ -119,9 +119,6 @@ pub struct NodeStatus {
     pub heartbeat: Option<Heartbeat>,
     /// When its last heartbeat came.
     pub heartbeat_at: Option<Instant>,
-    /// The faults latched in the first heartbeat heard from it in this session: what it held
-    /// before the host could have done anything (see [`super::claim`]).
-    pub first_faults: Option<Faults>,
     /// Its actuators' last reported positions (`None`: unknown).
     pub positions: [Option<Position>; MAX_ACTUATORS],
     /// When it was last heard from, in the session's listening time.
@@ -428,7 +425,6 @@ impl<T: Transport> Session<T> {
                 if h.state == DriveState::Disabled && (was_on || forgot_homes) {
                     status.rebooted = true;
                 }
-                status.first_faults.get_or_insert(h.faults);
                 status.heartbeat = Some(h);
                 status.heartbeat_at = Some(Instant::now());
             }
