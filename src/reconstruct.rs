@@ -241,7 +241,8 @@ pub struct ThreeColumns {
     pub mannequin: Girth,
 }
 
-/// `fit.json`: what the fit found and what the symmetric pose is.
+/// `fit.json`: what the fit found and what the symmetric pose is. Not the fit's wall time: the
+/// same scan gives the same bytes (the commands print the time).
 #[derive(Debug, Clone, Serialize)]
 pub struct FitReport {
     /// Per bone: fitted and symmetric rotation vectors (degrees; see `README.md`, pose).
@@ -257,8 +258,6 @@ pub struct FitReport {
     pub regions: Vec<RegionResidual>,
     /// LM iterations.
     pub iterations: usize,
-    /// The fit's wall time (s).
-    pub seconds: f64,
     /// Scan vertices whose skin weights were filled from their neighbours.
     pub rig_filled_vertices: usize,
 }
@@ -313,7 +312,6 @@ impl Reposed {
             residuals: self.fit.residuals,
             regions: self.residuals.clone(),
             iterations: self.fit.iterations,
-            seconds: self.fit_seconds,
             rig_filled_vertices: self.rig.filled,
         }
     }

@@ -16,6 +16,7 @@ mod controller_setpoints;
 mod controller_sim;
 mod controller_socketcan;
 mod demo;
+mod determinism;
 mod fitting;
 mod formats;
 mod fuzz_readers;

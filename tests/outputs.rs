@@ -3,23 +3,9 @@
 
 use crate::common;
 
-use common::{dressform, synthetic_scan};
+use common::{dressform, output_files, synthetic_scan};
 use dressform::scan::format::{Format, comment_value};
 use glam::DVec3;
-use std::path::Path;
-
-/// The files of an output directory (following links), by name, without hidden entries.
-fn outputs(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
-        .unwrap()
-        .flatten()
-        .map(|e| e.file_name().into_string().unwrap())
-        .filter(|n| !n.starts_with('.'))
-        .map(|n| (n.clone(), std::fs::read(dir.join(&n)).unwrap()))
-        .collect();
-    files.sort();
-    files
-}
 
 fn symmetrize(args: &[&str]) -> (i32, String, String) {
     let mut all = vec!["symmetrize"];
@@ -41,7 +27,7 @@ fn glb_for_cad_and_the_set_replaced_as_a_whole() {
     let args = [scan, "-o", out_s, "--format", "glb", "--units", "m", "--up", "y"];
     let (code, _, stderr) = symmetrize(&args);
     assert_eq!(code, 0, "{stderr}");
-    let names: Vec<String> = outputs(&out).into_iter().map(|(n, _)| n).collect();
+    let names: Vec<String> = output_files(&out).into_iter().map(|(n, _)| n).collect();
     assert_eq!(
         names,
         ["mannequin.glb", "measurements.json", "preview.png", "profiles.json", "sections.svg"],
@@ -66,7 +52,7 @@ fn glb_for_cad_and_the_set_replaced_as_a_whole() {
     let (code, _, stderr) = symmetrize(&[scan, "-o", out_s, "--scan-frame", "--up", "y"]);
     assert_eq!(code, 2, "{stderr}");
     // A failed command leaves the set as it was.
-    assert_eq!(outputs(&out).len(), 5);
+    assert_eq!(output_files(&out).len(), 5);
     assert!(out.join("mannequin.glb").is_file());
 
     // PLY in centimetres, Z up: read back with its header.
@@ -94,7 +80,7 @@ fn the_same_input_gives_the_same_bytes() {
                 .output()
                 .unwrap();
             assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
-            outputs(&out)
+            output_files(&out)
         })
         .collect();
     assert_eq!(runs[0].len(), 5, "mannequin, profiles, measurements and the two pictures");
@@ -117,7 +103,7 @@ fn a_full_disk_leaves_the_older_set_whole() {
     let args = ["symmetrize", scan.to_str().unwrap(), "-o", out.to_str().unwrap()];
     let (code, _, stderr) = dressform(&[&args[..], &["--torso-layers", "60"]].concat());
     assert_eq!(code, 0, "{stderr}");
-    let older = outputs(&out);
+    let older = output_files(&out);
 
     let mut limited = std::process::Command::new(env!("CARGO_BIN_EXE_dressform"));
     limited.args(args);
@@ -140,11 +126,11 @@ fn a_full_disk_leaves_the_older_set_whole() {
     let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error")).collect();
     assert_eq!(errors.len(), 1, "{stderr}");
     assert!(errors[0].contains("out/mannequin.obj: cannot write: File too large"), "{stderr}");
-    assert!(outputs(&out) == older, "the older set changed");
+    assert!(output_files(&out) == older, "the older set changed");
 
     let (code, _, stderr) = dressform(&args);
     assert_eq!(code, 0, "{stderr}");
-    assert!(outputs(&out) != older);
+    assert!(output_files(&out) != older);
     let sets = std::fs::read_dir(out.join(".dressform/sets")).unwrap().count();
     assert_eq!(sets, 1, "the failed run's partial set is gone");
 }

@@ -7,7 +7,7 @@
 
 use super::params::vertex_normals;
 use super::robust;
-use crate::mesh::{Mesh, topology};
+use crate::mesh::{Mesh, reduce, topology};
 use glam::{DMat3, DVec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -117,23 +117,19 @@ pub fn robust_distance(
             unmatched
         }
     };
-    let to_scan: f64 = (0..vertices.len())
-        .into_par_iter()
-        .map(|v| {
-            let hit = cloud.tree.nearest_one::<SquaredEuclidean>(&vertices[v].to_array());
-            pair(v, hit.item as usize)
-        })
-        .sum();
+    // Summed in a fixed order ([`reduce::sum`]): the arm starts compare these costs, and a
+    // rayon `sum` rounds differently from run to run.
+    let to_scan = reduce::sum(vertices.len(), |v| {
+        let hit = cloud.tree.nearest_one::<SquaredEuclidean>(&vertices[v].to_array());
+        pair(v, hit.item as usize)
+    });
     let coords: Vec<[f64; 3]> = vertices.iter().map(|p| p.to_array()).collect();
     let model_tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&coords);
-    let to_model: f64 = cloud
-        .samples
-        .par_iter()
-        .map(|&s| {
-            let hit = model_tree.nearest_one::<SquaredEuclidean>(&scan.points[s].to_array());
-            pair(hit.item as usize, s)
-        })
-        .sum();
+    let to_model = reduce::sum(cloud.samples.len(), |i| {
+        let s = cloud.samples[i];
+        let hit = model_tree.nearest_one::<SquaredEuclidean>(&scan.points[s].to_array());
+        pair(hit.item as usize, s)
+    });
     0.5 * (to_scan / vertices.len().max(1) as f64 + to_model / cloud.samples.len().max(1) as f64)
 }
 

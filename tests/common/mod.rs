@@ -66,6 +66,19 @@ pub fn dressform(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// The files of an output directory (following links), by name, without hidden entries.
+pub fn output_files(dir: &std::path::Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().into_string().unwrap())
+        .filter(|n| !n.starts_with('.'))
+        .map(|n| (n.clone(), std::fs::read(dir.join(&n)).unwrap()))
+        .collect();
+    files.sort();
+    files
+}
+
 use dressform::mesh::Mesh;
 use glam::DVec3;
 use std::collections::HashMap;
