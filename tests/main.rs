@@ -9,6 +9,7 @@ mod body_model;
 mod canonical_frame;
 mod controller_cli;
 mod controller_estop;
+mod controller_liveness;
 mod controller_pty;
 mod controller_safety;
 mod controller_setpoints;
