@@ -1,17 +1,26 @@
-//! Liveness that tells a node's silence from the link's, under tokio's paused clock on the
-//! in-process CAN bus (deterministic): every node quiet together is the link's stall, excused
-//! up to `LINK_STALL_LIMIT` however the nodes come back (one of them first: the race that made
-//! the others "lost"); longer, it is reported as a stalled link, not as a node lost; one node
-//! quiet while the others talk is lost, its silence outside the link's stalls counted.
+//! Liveness that tells a node's silence from the link's, and what a fault leaves behind.
+//!
+//! * Under tokio's paused clock, on the in-process CAN bus (deterministic): every node quiet
+//!   together is the link's stall, excused up to `LINK_STALL_LIMIT` however the nodes come
+//!   back (one of them first: the race that made the others "lost"); longer, it is reported
+//!   as a stalled link, not as a node lost; one node quiet while the others talk is lost, its
+//!   silence outside the link's stalls counted.
+//! * A fault during homing or during a move leaves no node Enabled: none latches a host
+//!   timeout once the host is gone (in-process, and over both ptys).
 
+use std::collections::BTreeMap;
 use std::time::Duration;
 
 use dressform::controller::session::{LINK_STALL_LIMIT, NODE_LOST_AFTER, Session, SessionError};
 use dressform::controller::transport::sim::SimBus;
+use dressform::controller::{Connection, DriveError, DriveOptions, LinkSpec, drive};
+use dressform::setpoints::SetPoints;
+use firmware_protocol::drive::{DriveState, Faults};
 use form_description::reference;
 use sim::bus::can::{CanBus, CanKind};
 use sim::fault::FaultSpec;
-use sim::robot::{SimOptions, SimulatedForm};
+use sim::robot::{FormState, SimOptions, SimulatedForm};
+use sim::serve::{ServeConfig, Transport as Served, serve};
 use tokio::time::Instant;
 
 /// The reference form on an in-process classic CAN bus with `faults`, a session with it
@@ -126,4 +135,78 @@ async fn a_silent_node_is_lost_on_its_own_silence_the_links_stall_left_out() {
             && noticed <= expected + Duration::from_millis(40),
         "noticed at {noticed:?}"
     );
+}
+
+/// A few actuators on several nodes, all at `mm`.
+fn setpoints(mm: f64) -> SetPoints {
+    let positions: BTreeMap<String, f64> = ["chest-l1", "chest-r1", "waist-front", "hip-back"]
+        .into_iter()
+        .map(|id| (id.to_string(), mm))
+        .collect();
+    SetPoints::new("reference", positions)
+}
+
+/// No node is left Enabled or Homing, none latched a host timeout; the faulty node 2 holds
+/// its following error.
+fn nothing_left_enabled(truth: &FormState) {
+    for node in &truth.nodes {
+        assert!(
+            !matches!(node.state, DriveState::Enabled | DriveState::Homing),
+            "node {} left {:?}: {:?}",
+            node.node.get(),
+            node.state,
+            truth.nodes
+        );
+        assert!(!node.faults.contains(Faults::HOST_TIMEOUT), "{:?}", truth.nodes);
+    }
+    let chest = truth.nodes.iter().find(|n| n.node.get() == 2).unwrap();
+    assert!(chest.faults.contains(Faults::FOLLOWING_ERROR), "{:?}", truth.nodes);
+}
+
+/// A jam during homing (from the start) and one during the move (homing and discovery take
+/// about 1.2 s; the move is under way at 2 s): the drive fails naming the fault, and a second
+/// after it ended no node is Enabled and none latched a host timeout (every node but the
+/// faulty one used to stay Enabled and time out once the host had gone).
+#[tokio::test(start_paused = true)]
+async fn a_fault_during_homing_or_a_move_leaves_no_node_enabled() {
+    for faults in ["chest-l1:stall@0s", "chest-l1:stall@2s"] {
+        let faults: FaultSpec = faults.parse().unwrap();
+        let bus = CanBus::with(CanKind::CLASSIC_1M, &faults, None);
+        let form =
+            SimulatedForm::on_can(&reference(), &bus, &faults, &SimOptions::default()).unwrap();
+        let options = DriveOptions { min_duration: Duration::from_secs(4), ..Default::default() };
+        let error = drive(SimBus::attach(&bus), &reference(), &setpoints(30.0), &options, |_| {})
+            .await
+            .unwrap_err();
+        assert!(
+            matches!(error, DriveError::Session(SessionError::Fault(ref f)) if f.node.address == 2),
+            "{faults}: {error}"
+        );
+        tokio::time::sleep(Duration::from_secs(1)).await;
+        nothing_left_enabled(&form.state());
+    }
+}
+
+/// The same over both ptys, in real time: a jam during homing leaves no node Enabled.
+#[test]
+fn a_fault_during_homing_over_a_pty_leaves_no_node_enabled() {
+    for transport in [Served::SerialPty, Served::SlcanPty] {
+        let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+        let mut config = ServeConfig::new(reference(), transport);
+        config.faults = "chest-l1:stall@0s".parse().unwrap();
+        let server = serve(config).unwrap();
+        let path = server.device_path().to_path_buf();
+        let spec = match transport {
+            Served::SerialPty => LinkSpec::Serial(path),
+            Served::SlcanPty => LinkSpec::Slcan(path),
+        };
+        let connection = Connection::open(&spec).unwrap();
+        let options = DriveOptions::default();
+        let error = runtime
+            .block_on(drive(connection, &reference(), &setpoints(30.0), &options, |_| {}))
+            .unwrap_err();
+        assert!(error.to_string().contains("fault on node 2 (chest)"), "{transport:?}: {error}");
+        std::thread::sleep(Duration::from_secs(1));
+        nothing_left_enabled(&server.form().state());
+    }
 }

@@ -37,9 +37,10 @@
 //!
 //! **Faults** are found one way during homing and during a move ([`Session::fault`]): an
 //! `Emergency` event with a fault code, or a heartbeat in Fault; the session halts every
-//! node and reports the node and actuator in words at once. Latched faults found at the
-//! start are cleared by [`Session::reset_faults`] only within what the caller allows (see
-//! [`super::faults`]).
+//! node, then disables each ([`Session::stop_for_fault`]: none stays Enabled to latch a host
+//! timeout once the host is gone), and reports the node and actuator in words. Latched
+//! faults found at the start are cleared by [`Session::reset_faults`] only within what the
+//! caller allows (see [`super::faults`]).
 //!
 //! Safety: the session never sends targets itself; `motion` builds them from
 //! [`SafeTarget`](crate::safety::SafeTarget)s only. Every packet goes through the link's
@@ -1031,6 +1032,21 @@ impl<T: Transport> Session<T> {
         }))
     }
 
+    /// Stops the form after `fault` (during homing or a move): broadcasts `Halt`, so every
+    /// node stops at once, then disables every node, each acknowledging (refusals ignored: the
+    /// faulty node is in Fault), so that none stays Enabled to latch a host timeout once the
+    /// host is gone. Returns the error to report: the fault, or what failed the link meanwhile
+    /// (an e-stop, the link itself).
+    pub async fn stop_for_fault(&mut self, fault: Fault) -> SessionError {
+        match self.halt_all().await {
+            Ok(()) => match self.disable_all().await {
+                Ok(()) => SessionError::Fault(fault),
+                Err(e) => e,
+            },
+            Err(e) => e,
+        }
+    }
+
     /// Consumes every node's events: the first fault is returned, warnings are kept.
     fn take_fault_event(&mut self, warnings: &mut Vec<String>) -> Option<Fault> {
         let mut found = None;
@@ -1096,8 +1112,7 @@ impl<T: Transport> Session<T> {
                 .await?;
             // A fault during homing: reported at once, as during a move.
             if let Some(fault) = self.fault(&mut warnings).await? {
-                self.halt_all().await?;
-                return Err(SessionError::Fault(fault));
+                return Err(self.stop_for_fault(fault).await);
             }
             if finished && !rebooted(self) {
                 return Ok(());
