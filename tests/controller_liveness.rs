@@ -7,13 +7,21 @@
 //!   silence outside the link's stalls counted.
 //! * A fault during homing or during a move leaves no node Enabled: none latches a host
 //!   timeout once the host is gone (in-process, and over both ptys).
+//! * Real time, over real pseudo-terminals: `dressform sim` as a child process, stopped with
+//!   SIGSTOP for 0.5 s and 1.5 s in the middle of a move (the drive finishes and no node holds
+//!   a fault afterwards) and for 2.5 s (the drive fails: the link stalled). Tries per case and
+//!   link: `DRESSFORM_STALL_TRIES` (default 2; `tests/scripts/stress-test.sh` sets 20).
 
 use std::collections::BTreeMap;
+use std::io::{BufRead, BufReader};
+use std::path::PathBuf;
+use std::process::{Child, ChildStdout, Command, Stdio};
+use std::sync::mpsc;
 use std::time::Duration;
 
 use dressform::controller::session::{LINK_STALL_LIMIT, NODE_LOST_AFTER, Session, SessionError};
 use dressform::controller::transport::sim::SimBus;
-use dressform::controller::{Connection, DriveError, DriveOptions, LinkSpec, drive};
+use dressform::controller::{Connection, DriveError, DriveOptions, LinkSpec, drive, status};
 use dressform::setpoints::SetPoints;
 use firmware_protocol::drive::{DriveState, Faults};
 use form_description::reference;
@@ -209,4 +217,157 @@ fn a_fault_during_homing_over_a_pty_leaves_no_node_enabled() {
         std::thread::sleep(Duration::from_secs(1));
         nothing_left_enabled(&server.form().state());
     }
+}
+
+/// How many tries per stall and link the real-time stall test makes.
+fn tries() -> usize {
+    std::env::var("DRESSFORM_STALL_TRIES").ok().and_then(|t| t.parse().ok()).unwrap_or(2)
+}
+
+/// How long into the move the simulator is stopped (progress comes every 50 ms).
+const STOP_AT: Duration = Duration::from_millis(300);
+/// How long the moves last: the longest stop excused (1.5 s) ends well before, on a loaded
+/// machine too.
+const MOVE: Duration = Duration::from_secs(3);
+/// How long a drive may take to start moving: the first homes every node (up to 12 s at
+/// the nodes' homing speed), and a loaded machine is slow.
+const START_TIMEOUT: Duration = Duration::from_secs(60);
+
+/// `dressform sim` as a child process, serving the reference form on a pty.
+struct SimProcess {
+    child: Child,
+    path: PathBuf,
+    // Kept open: the simulator's standard output.
+    _stdout: BufReader<ChildStdout>,
+}
+
+impl SimProcess {
+    fn start(flag: &str) -> Self {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_dressform"))
+            .args(["sim", flag])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("dressform sim starts");
+        let mut stdout = BufReader::new(child.stdout.take().expect("stdout"));
+        let mut line = String::new();
+        stdout.read_line(&mut line).expect("the pty's path");
+        let path = PathBuf::from(line.trim());
+        assert!(path.starts_with("/dev/"), "{line:?}");
+        Self { child, path, _stdout: stdout }
+    }
+
+    fn signal(&self, signal: libc::c_int) {
+        let pid = libc::pid_t::try_from(self.child.id()).unwrap();
+        // SAFETY: kill has no memory effects; `pid` is our child, not yet reaped.
+        assert_eq!(unsafe { libc::kill(pid, signal) }, 0);
+    }
+}
+
+impl Drop for SimProcess {
+    fn drop(&mut self) {
+        self.signal(libc::SIGCONT);
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// One drive to `mm` over `spec`, the simulator stopped for `stop` from [`STOP_AT`] into
+/// the move: the drive's outcome (`Ok` or the error in words), and how long the simulator
+/// really was stopped.
+fn drive_through_a_stop(
+    sim: &SimProcess,
+    spec: &LinkSpec,
+    stop: Duration,
+    mm: f64,
+) -> (Result<(), String>, Duration) {
+    let (moving, started) = mpsc::channel();
+    let spec = spec.clone();
+    let driver = std::thread::spawn(move || {
+        let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+        let connection = Connection::open(&spec).map_err(|e| e.to_string())?;
+        let options = DriveOptions { min_duration: MOVE, ..Default::default() };
+        let mut told = false;
+        let progress = |p: &dressform::controller::Progress| {
+            if !told && p.elapsed >= STOP_AT {
+                told = true;
+                let _ = moving.send(());
+            }
+        };
+        let report = runtime
+            .block_on(drive(connection, &reference(), &setpoints(mm), &options, progress))
+            .map_err(|e| e.to_string())?;
+        if report.converged() { Ok(()) } else { Err(format!("not converged: {report:?}")) }
+    });
+    if started.recv_timeout(START_TIMEOUT).is_err() {
+        let outcome = driver.join().unwrap();
+        return (Err(format!("never {STOP_AT:?} into the move: {outcome:?}")), Duration::ZERO);
+    }
+    let stopped = std::time::Instant::now();
+    sim.signal(libc::SIGSTOP);
+    std::thread::sleep(stop);
+    sim.signal(libc::SIGCONT);
+    let stopped = stopped.elapsed();
+    (driver.join().unwrap(), stopped)
+}
+
+/// Every node answers, Disabled, no fault latched.
+fn no_fault_latched(spec: &LinkSpec) -> Result<(), String> {
+    let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+    let connection = Connection::open(spec).map_err(|e| e.to_string())?;
+    let nodes = runtime
+        .block_on(status(connection, &reference(), Duration::from_millis(200)))
+        .map_err(|e| e.to_string())?;
+    match nodes.iter().find(|n| n.state.as_deref() != Some("Disabled") || !n.faults.is_empty()) {
+        Some(node) => Err(format!("after the drive: {node:?}")),
+        None => Ok(()),
+    }
+}
+
+/// The simulated form stopped with SIGSTOP mid-move, [`tries`] times per stop: 0.5 s and
+/// 1.5 s are the link's stalls (the drive finishes, no node lost, no node latched a host
+/// timeout once the simulator went on); 2.5 s is past `LINK_STALL_LIMIT` and reported as
+/// the link's stall, never as a node lost.
+fn stopped_simulator(flag: &str, link: fn(PathBuf) -> LinkSpec) {
+    let sim = SimProcess::start(flag);
+    let spec = link(sim.path.clone());
+    let mut failures = Vec::new();
+    let mut drives = 0;
+    for run in 1..=tries() {
+        for stop in [500, 1500, 2500].map(Duration::from_millis) {
+            drives += 1;
+            let mm = if drives % 2 == 0 { 4.0 } else { 8.0 };
+            let (outcome, stopped) = drive_through_a_stop(&sim, &spec, stop, mm);
+            eprintln!("{flag} try {run}, stop {stop:?} (really {stopped:?}): {outcome:?}");
+            let outcome = if stop < LINK_STALL_LIMIT {
+                outcome.and_then(|()| no_fault_latched(&spec))
+            } else {
+                match outcome {
+                    Err(e) if e.starts_with("the link carried nothing from any node") => Ok(()),
+                    Err(e) => Err(e),
+                    Ok(()) => Err("the drive went through a stall past the limit".into()),
+                }
+            };
+            if let Err(e) = outcome {
+                failures.push(format!("try {run}, stop {stop:?} (really {stopped:?}): {e}"));
+            }
+            if stop >= LINK_STALL_LIMIT {
+                // The nodes were Enabled when the host gave up: they latch a host timeout
+                // once the simulator goes on, which the next drive clears.
+                std::thread::sleep(Duration::from_millis(500));
+            }
+        }
+    }
+    let list = failures.join("\n");
+    assert!(failures.is_empty(), "{flag}: {} of {drives} drives failed:\n{list}", failures.len());
+}
+
+#[test]
+fn a_stopped_simulator_is_the_links_stall_over_serial() {
+    stopped_simulator("--serial-pty", LinkSpec::Serial);
+}
+
+#[test]
+fn a_stopped_simulator_is_the_links_stall_over_slcan() {
+    stopped_simulator("--slcan-pty", LinkSpec::Slcan);
 }
