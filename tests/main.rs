@@ -10,6 +10,7 @@ mod canonical_frame;
 mod controller_claim;
 mod controller_cli;
 mod controller_estop;
+mod controller_liveness;
 mod controller_pty;
 mod controller_safety;
 mod controller_setpoints;

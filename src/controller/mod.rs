@@ -20,8 +20,8 @@
 //! Safety rules, all enforced here: targets come only from [`SafeTarget`]s built against the
 //! description's strokes (checked against what every node reports); the SYNC duration is
 //! never shorter than the shortest feasible for every actuator; a fault (during homing or a
-//! move) broadcasts `Halt`; a lost node, a reboot that cannot be resumed or a failed link end
-//! the move with an error; an e-stop (another terminal, a signal) latches the link's [`Gate`]
+//! move) broadcasts `Halt` and disables every node; a lost node, a stalled link, a reboot that
+//! cannot be resumed or a failed link end the move with an error; an e-stop (another terminal, a signal) latches the link's [`Gate`]
 //! and broadcasts `EmergencyStop` without waiting for the session; a hardware fault is never
 //! cleared without the caller's say-so.
 

@@ -10,10 +10,10 @@
 //!
 //! Safety: targets are [`SafeTarget`]s, and [`node_targets`] is the one place that turns them
 //! into wire positions. A fault event or a node in Fault broadcasts `Halt` (the faulty node is
-//! already stopping) and ends the move with the actuator and the reason
-//! ([`Session::fault`], the same path as during homing). A node that reboots
-//! is re-identified, enabled, homed and given its targets again with a new SYNC (at most
-//! twice per move), or the move fails clearly.
+//! already stopping), disables every node and ends the move with the actuator and the reason
+//! ([`Session::fault`], [`Session::stop_for_fault`], the same path as during homing). A node
+//! that reboots is re-identified, enabled, homed and given its targets again with a new SYNC
+//! (at most twice per move), or the move fails clearly.
 
 use std::collections::BTreeMap;
 use std::time::Duration;
@@ -193,8 +193,7 @@ pub async fn run<T: Transport>(
         progress(&progress_of(session, plan, tol, started.elapsed(), planned));
         // Faults first: they stop everything.
         if let Some(fault) = session.fault(&mut warnings).await? {
-            session.halt_all().await?;
-            return Err(SessionError::Fault(fault).into());
+            return Err(session.stop_for_fault(fault).await.into());
         }
         let rebooted: Vec<NodeId> =
             session.nodes().iter().filter(|(_, s)| s.rebooted).map(|(&n, _)| n).collect();

@@ -24,14 +24,23 @@
 //!   heartbeat, it is [`POLLS_LOST`] polls in a row unanswered: a host that polls slowly (busy,
 //!   or behind a slow adapter) does not make a node that answers every poll silent. Received
 //!   packets are always taken before silence is judged;
+//! * a node's silence is told from the link's: every time the whole link carried nothing for
+//!   more than [`LINK_QUIET`] (on CAN every node speaks every 20 ms) is the link's stall, and
+//!   the session remembers them, so a node's silence leaves out every stall after its last
+//!   packet — also once the link talks again, whichever node is heard first (the session used
+//!   to excuse only a stall still going on, and after a stall of 0.5 s the first node heard
+//!   made the others lost). A stall longer than [`LINK_STALL_LIMIT`] is an error of its own,
+//!   [`SessionError::LinkStalled`], on every link: the adapter, cable or bus stopped, not a
+//!   node. One node quiet while the others talk is lost after [`NODE_LOST_AFTER`], as ever;
 //! * a node whose heartbeat falls back to Disabled unasked (or forgets its homes) has
 //!   rebooted.
 //!
 //! **Faults** are found one way during homing and during a move ([`Session::fault`]): an
 //! `Emergency` event with a fault code, or a heartbeat in Fault; the session halts every
-//! node and reports the node and actuator in words at once. Latched faults found at the
-//! start are cleared by [`Session::reset_faults`] only within what the caller allows (see
-//! [`super::faults`]).
+//! node, then disables each ([`Session::stop_for_fault`]: none stays Enabled to latch a host
+//! timeout once the host is gone), and reports the node and actuator in words. Latched
+//! faults found at the start are cleared by [`Session::reset_faults`] only within what the
+//! caller allows (see [`super::faults`]).
 //!
 //! Safety: the session never sends targets itself; `motion` builds them from
 //! [`SafeTarget`](crate::safety::SafeTarget)s only. Every packet goes through the link's
@@ -74,8 +83,8 @@ pub const POLLS_LOST: u32 = (timing::NODE_LOST_AFTER_MS / timing::HEARTBEAT_PERI
 /// with margin. A single silent node is still found within [`NODE_LOST_AFTER`], since the
 /// others keep talking.
 pub const LINK_STALL_LIMIT: Duration = Duration::from_secs(2);
-/// On CAN, the link carrying nothing at all for this long (two feedback periods of every
-/// node) is the link's stall, not the nodes' silence.
+/// On CAN, the link carrying nothing at all for longer than this (two feedback periods of
+/// every node) is the link's stall, not the nodes' silence.
 const LINK_QUIET: Duration = Duration::from_millis(2 * timing::FEEDBACK_PERIOD_MS as u64);
 /// The longest a gap between two wakes of the receive loop counts towards a node's silence:
 /// the loop wakes at least every answer timeout (60 ms on serial), so a longer gap is the
@@ -123,6 +132,9 @@ pub struct NodeStatus {
     pub positions: [Option<Position>; MAX_ACTUATORS],
     /// When it was last heard from, in the session's listening time.
     pub heard: Option<Duration>,
+    /// The link's stalls excused up to then (see [`Session::excused`]): later stalls are
+    /// left out of its silence.
+    pub excused_at: Duration,
     /// Polls in a row it left unanswered (serial), since it was last heard from.
     pub unanswered_polls: u32,
     /// Its `Emergency` events not yet handled, oldest first.
@@ -195,7 +207,8 @@ pub enum SessionError {
         /// How many times it was sent.
         attempts: u8,
     },
-    /// A node went silent (CAN: no heartbeat for [`NODE_LOST_AFTER`] of listening time).
+    /// A node went silent (CAN: no heartbeat for [`NODE_LOST_AFTER`] of listening time, the
+    /// link's stalls left out).
     #[error("node {node}: lost: nothing heard for {} ms (limit {} ms)", silent.as_millis(), NODE_LOST_AFTER.as_millis())]
     NodeLost {
         /// The node.
@@ -210,6 +223,13 @@ pub enum SessionError {
         node: u8,
         /// How long it had been silent when noticed.
         silent: Duration,
+    },
+    /// The whole link carried nothing from any node for longer than [`LINK_STALL_LIMIT`]:
+    /// the link stalled (or the form lost power), which is no one node's loss.
+    #[error("the link carried nothing from any node for {:.1} s (limit {} s): the adapter, cable or bus stalled, or the form lost power", quiet.as_secs_f64(), LINK_STALL_LIMIT.as_secs())]
+    LinkStalled {
+        /// How long it had carried nothing when noticed (or when it spoke again).
+        quiet: Duration,
     },
     /// Homing did not finish in time.
     #[error("homing did not finish within {} s: {}", .timeout.as_secs(), .nodes.join(", "))]
@@ -279,6 +299,10 @@ pub struct Session<T> {
     clock: ListeningClock,
     /// When any node was last heard from, in listening time.
     heard_any: Duration,
+    /// The link's ended stalls so far, in listening time (see [`Session::excused`]).
+    ended_stalls: Duration,
+    /// A stall longer than [`LINK_STALL_LIMIT`] that ended before it was noticed (the first).
+    overlong_stall: Option<Duration>,
     /// Packets heard from the described nodes so far.
     heard_count: u64,
     /// Since when unanswered exchanges have been excused as the link's stall (see
@@ -316,6 +340,12 @@ const CAN_ANSWER_TIMEOUT: Duration = Duration::from_millis(30);
 /// due sooner.
 const CHECK_PERIOD: Duration = Duration::from_millis(10);
 
+/// How much of a whole-link silence of `quiet` was the link's stall: all of it once longer
+/// than [`LINK_QUIET`], up to [`LINK_STALL_LIMIT`] (beyond that the link is reported stalled).
+fn stall_part(quiet: Duration) -> Duration {
+    if quiet > LINK_QUIET { quiet.min(LINK_STALL_LIMIT) } else { Duration::ZERO }
+}
+
 /// How long to wait for an answer before retrying.
 fn answer_timeout(link: Link) -> Duration {
     match link {
@@ -342,6 +372,8 @@ impl<T: Transport> Session<T> {
             stopped,
             clock: ListeningClock::new(),
             heard_any: Duration::ZERO,
+            ended_stalls: Duration::ZERO,
+            overlong_stall: None,
             heard_count: 0,
             stalled_since: None,
         }
@@ -402,16 +434,18 @@ impl<T: Transport> Session<T> {
         if packet.message.code().direction() != firmware_protocol::message::Direction::NodeToHost {
             return;
         }
-        let Some(status) = self.nodes.get_mut(&node) else {
+        if !self.nodes.contains_key(&node) {
             if !self.unexpected.contains(&node.get()) {
                 self.unexpected.push(node.get());
             }
             return;
-        };
+        }
         let now = self.clock.tick();
+        self.link_heard(now);
+        let excused = self.ended_stalls;
+        let Some(status) = self.nodes.get_mut(&node) else { return };
         status.heard = Some(now);
-        self.heard_any = now;
-        self.heard_count += 1;
+        status.excused_at = excused;
         status.unanswered_polls = 0;
         match packet.message {
             Message::Heartbeat(h) => {
@@ -439,6 +473,36 @@ impl<T: Transport> Session<T> {
             Message::Capabilities(c) => status.capabilities = Some(c),
             _ => {}
         }
+    }
+
+    /// The link carried a packet from a described node at listening time `now`: the
+    /// whole-link silence it ends, if longer than [`LINK_QUIET`], was the link's stall (see
+    /// [`Session::excused`]); one longer than [`LINK_STALL_LIMIT`] is kept for
+    /// [`Session::lost`] to report.
+    fn link_heard(&mut self, now: Duration) {
+        if self.heard_count > 0 {
+            let quiet = now.saturating_sub(self.heard_any);
+            self.ended_stalls += stall_part(quiet);
+            if quiet > LINK_STALL_LIMIT {
+                self.overlong_stall.get_or_insert(quiet);
+            }
+        }
+        self.heard_any = now;
+        self.heard_count += 1;
+    }
+
+    /// How long the whole link has carried nothing from any node at listening time `now`
+    /// (zero before it carried anything).
+    fn link_quiet(&self, now: Duration) -> Duration {
+        if self.heard_count == 0 { Duration::ZERO } else { now.saturating_sub(self.heard_any) }
+    }
+
+    /// The link's stalls up to listening time `now`, the one going on included: the time the
+    /// whole link carried nothing for longer than [`LINK_QUIET`], each stall counted up to
+    /// [`LINK_STALL_LIMIT`]. A node's silence leaves out what this grew by since it was last
+    /// heard ([`NodeStatus::excused_at`]), whichever node the link carried first afterwards.
+    fn excused(&self, now: Duration) -> Duration {
+        self.ended_stalls + stall_part(self.link_quiet(now))
     }
 
     /// Fails once the link was e-stopped.
@@ -617,21 +681,26 @@ impl<T: Transport> Session<T> {
         Ok(())
     }
 
-    /// The first node lost (see the module docs): on serial, one that left [`POLLS_LOST`]
-    /// polls in a row unanswered; on CAN, one not heard for [`NODE_LOST_AFTER`] of listening
-    /// time.
+    /// The link stalled, or the first node lost (see the module docs): on every link, nothing
+    /// heard from any node for longer than [`LINK_STALL_LIMIT`] (going on, or ended since the
+    /// last look) is the link's stall; on serial, a node that left [`POLLS_LOST`] polls in a
+    /// row unanswered is lost; on CAN, one not heard for [`NODE_LOST_AFTER`] of listening time,
+    /// the link's stalls since its last packet left out ([`Session::excused`]: on CAN every
+    /// node speaks every 20 ms, so the whole link quiet is the link's stall — a busy host's tty
+    /// layer holding every byte, a stopped adapter — while one node quiet among talking ones
+    /// is that node's silence).
     fn lost(&mut self) -> Option<SessionError> {
         let now = self.clock.tick();
+        let quiet = self.link_quiet(now);
+        let overlong = (quiet > LINK_STALL_LIMIT).then_some(quiet);
+        if let Some(quiet) = self.overlong_stall.or(overlong) {
+            return Some(SessionError::LinkStalled { quiet });
+        }
         let serial = self.link() == Link::Serial;
-        // While the whole link is quiet (on CAN every node speaks every 20 ms, so that is the
-        // link's stall: a busy host's tty layer holding every byte), silence counts only up
-        // to the last time it carried anything — up to a limit. A single silent node is
-        // found as before, since the others keep talking.
-        let quiet = now.saturating_sub(self.heard_any);
-        let until =
-            if quiet > LINK_QUIET && quiet <= LINK_STALL_LIMIT { self.heard_any } else { now };
+        let excused = self.excused(now);
         self.nodes.iter().find_map(|(&node, status)| {
-            let silent = until.saturating_sub(status.heard?);
+            let stalled = excused.saturating_sub(status.excused_at);
+            let silent = now.saturating_sub(status.heard?).saturating_sub(stalled);
             let node = node.get();
             if serial {
                 (status.unanswered_polls >= POLLS_LOST)
@@ -685,8 +754,10 @@ impl<T: Transport> Session<T> {
         }
         let status = self.nodes.get(&node).cloned().unwrap_or_default();
         let now = self.clock.tick();
+        let excused = self.excused(now);
         if let Some(status) = self.nodes.get_mut(&node) {
             status.heard = Some(now);
+            status.excused_at = excused;
         }
         Ok(self.check(node, &status))
     }
@@ -973,6 +1044,21 @@ impl<T: Transport> Session<T> {
         }))
     }
 
+    /// Stops the form after `fault` (during homing or a move): broadcasts `Halt`, so every
+    /// node stops at once, then disables every node, each acknowledging (refusals ignored: the
+    /// faulty node is in Fault), so that none stays Enabled to latch a host timeout once the
+    /// host is gone. Returns the error to report: the fault, or what failed the link meanwhile
+    /// (an e-stop, the link itself).
+    pub async fn stop_for_fault(&mut self, fault: Fault) -> SessionError {
+        match self.halt_all().await {
+            Ok(()) => match self.disable_all().await {
+                Ok(()) => SessionError::Fault(fault),
+                Err(e) => e,
+            },
+            Err(e) => e,
+        }
+    }
+
     /// Consumes every node's events: the first fault is returned, warnings are kept.
     fn take_fault_event(&mut self, warnings: &mut Vec<String>) -> Option<Fault> {
         let mut found = None;
@@ -1038,8 +1124,7 @@ impl<T: Transport> Session<T> {
                 .await?;
             // A fault during homing: reported at once, as during a move.
             if let Some(fault) = self.fault(&mut warnings).await? {
-                self.halt_all().await?;
-                return Err(SessionError::Fault(fault));
+                return Err(self.stop_for_fault(fault).await);
             }
             if finished && !rebooted(self) {
                 return Ok(());

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite on a busy machine: `cargo test --workspace` while 4 CPU-bound
 # processes load every core, as on a studio PC doing other work or a shared CI runner.
-# Real-time tests (ptys, the e-stop, liveness) must pass here too. Not part of CI.
+# Real-time tests (ptys, the e-stop, liveness, a stopped simulator) must pass here too. Not
+# part of CI.
 #
 #   tests/scripts/stress-test.sh [runs]     # default 1; the README reports 3 in a row
 set -euo pipefail
@@ -9,6 +10,9 @@ cd "$(dirname "$0")/../.."
 
 runs=${1:-1}
 hogs=4
+# The simulated form stopped mid-move (SIGSTOP for 0.5, 1.5 and 2.5 s) this many times per
+# stop and link (tests/controller_liveness.rs; 2 without the script).
+export DRESSFORM_STALL_TRIES=${DRESSFORM_STALL_TRIES:-20}
 
 # Build first, unloaded: the load is for the tests, not the compiler.
 cargo test --workspace --no-fail-fast --no-run
@@ -28,7 +32,8 @@ for run in $(seq 1 "$runs"); do
         sh -c 'while :; do :; done' &
         pids+=("$!")
     done
-    echo "== run $run of $runs: cargo test --workspace with $hogs CPU-bound processes"
+    echo "== run $run of $runs: cargo test --workspace with $hogs CPU-bound processes" \
+        "($DRESSFORM_STALL_TRIES tries per simulator stop)"
     start=$(date +%s)
     if ! cargo test --workspace --no-fail-fast; then
         echo "== run $run FAILED after $(( $(date +%s) - start )) s"

@@ -7,6 +7,11 @@
 //! nodes' watchdogs leave both out ([`Stalls`]): the simulator itself (its process
 //! descheduled on a busy machine), and the pseudo-terminal the host talks through (the
 //! kernel holding its bytes, measured with a [`Canary`]). Each counts beyond [`STALL`].
+//!
+//! A wake's work runs at the instant its stall was measured ([`Stalls::excuse`] returns it):
+//! a process stopped in between (SIGSTOP, or descheduled right after the canary's system
+//! calls) would otherwise tick the watchdog at an instant after a stall not yet excused, and
+//! latch a host timeout no wire causes; the next wake excuses that stall instead.
 
 use std::io;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
@@ -41,8 +46,9 @@ impl Stalls {
     }
 
     /// At a wake of the runner: tells `nodes` the stall since the last wake, the runner's
-    /// own or the link's (the larger: they overlap), beyond [`STALL`].
-    fn excuse(&mut self, nodes: &[SharedNode]) {
+    /// own or the link's (the larger: they overlap), beyond [`STALL`]. Returns the instant
+    /// measured, at which the wake's work is to be done (see the module docs).
+    fn excuse(&mut self, nodes: &[SharedNode]) -> Instant {
         let now = Instant::now();
         let own = now.saturating_duration_since(self.awake).saturating_sub(STALL);
         self.awake = now;
@@ -56,6 +62,7 @@ impl Stalls {
                 lock(node).node.excuse(lost);
             }
         }
+        now
     }
 }
 
@@ -89,13 +96,12 @@ pub(crate) async fn node_on_can(
             }
             _ = ticker.tick() => Woken::Tick,
         };
-        stalls.excuse(std::slice::from_ref(&node));
+        let now = stalls.excuse(std::slice::from_ref(&node));
         match woken {
             Woken::Frame(None) => return,
             Woken::Frame(Some(frame)) => {
                 // Frames that are not this protocol's are not for the node.
                 let Ok(packet) = can::decode(&frame) else { continue };
-                let now = Instant::now();
                 let (delay, answer) = lock(&node).receive(now, &packet);
                 if delay.is_zero() {
                     send(&sender, &answer);
@@ -106,13 +112,12 @@ pub(crate) async fn node_on_can(
                 }
             }
             Woken::Delayed => {
-                let now = Instant::now();
                 let due = delayed.partition_point(|(t, _)| *t <= now);
                 let packets: Vec<Packet> = delayed.drain(..due).map(|(_, p)| p).collect();
                 send(&sender, &packets);
             }
             Woken::Tick => {
-                let packets = lock(&node).tick(Instant::now());
+                let packets = lock(&node).tick(now);
                 send(&sender, &packets);
             }
         }
@@ -147,17 +152,15 @@ pub(crate) async fn nodes_on_serial(
     let mut next_tick = Instant::now();
     loop {
         let request = line.next_request(next_tick).await?;
-        stalls.excuse(nodes);
+        let now = stalls.excuse(nodes);
         match request {
             Some(request) => {
-                let now = Instant::now();
                 for node in nodes {
                     let (delay, answer) = lock(node).receive(now, &request.packet);
                     line.send(request.seq, &answer, delay);
                 }
             }
             None => {
-                let now = Instant::now();
                 for node in nodes {
                     // Serial nodes never speak unasked: a tick sends nothing.
                     lock(node).tick(now);
