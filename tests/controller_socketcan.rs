@@ -6,11 +6,13 @@
 //! is unit-tested in `controller::transport::socketcan`.)
 //!
 //! When it runs, the rule: SocketCAN is a capability of the kernel, not a tool to install.
-//! Opening needs `socket(AF_CAN)` and the interface, which some kernels lack (this project's
-//! CI machine among them): then the test says so and skips, or fails with
-//! `DRESSFORM_REQUIRE_SOCKETCAN=1`. It does not follow `DRESSFORM_REQUIRE_PEERS`: CI sets that
-//! to require the peer tools it installs, and a kernel feature CI cannot have would fail every
-//! run. Once SocketCAN is there, python-can is a peer like any other: missing, the peer part
+//! Opening needs `socket(AF_CAN)` and the interface, which some kernels lack: then the test
+//! prints that it did not run and why (no SocketCAN in the kernel, or no such interface) and
+//! passes, or fails with `DRESSFORM_REQUIRE_SOCKETCAN=1`. CI (`.ci/run`) creates `vcan0` where
+//! the kernel allows it and sets that variable there; where not, it says in its summary that
+//! this test did not run. It does not follow `DRESSFORM_REQUIRE_PEERS`: CI sets that to require
+//! the peer tools it installs, and a kernel feature a machine lacks is not something CI can
+//! install. Once SocketCAN is there, python-can is a peer like any other: missing, the peer part
 //! skips, or fails with `DRESSFORM_REQUIRE_PEERS=1`. Every outcome after that is checked: a
 //! frame that does not arrive, or arrives changed, either way, fails the test.
 
@@ -37,20 +39,40 @@ fn open_pair(interface: &str) -> Result<(SocketCan, SocketCan), String> {
     Ok((open()?, open()?))
 }
 
+/// Why `interface` could not be opened (`error`), in plain words: opening looks the interface
+/// up before it makes the socket, so a kernel without SocketCAN also reports "No such device";
+/// a CAN socket bound to no interface in particular tells the two apart.
+fn why_not(interface: &str, error: &str) -> String {
+    use socketcan::Socket as _;
+    match socketcan::CanSocket::open_iface(0) {
+        Err(e) => format!(
+            "this kernel has no SocketCAN (socket(AF_CAN) fails: {e}); opening {interface}: {error}"
+        ),
+        Ok(_) => format!(
+            "the kernel has SocketCAN, but opening {interface} fails: {error} (create it: \
+             `ip link add dev {interface} type vcan && ip link set up {interface}`)"
+        ),
+    }
+}
+
 #[test]
 fn a_packet_crosses_a_real_socketcan_interface() {
     let interface = std::env::var("DRESSFORM_CAN_IFACE").unwrap_or_else(|_| "vcan0".into());
     let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
     // The tokio socket must be opened inside the runtime.
-    let pair = runtime.block_on(async { open_pair(&interface) });
-    if let Err(why) = &pair {
-        assert!(why.contains(&interface), "the error does not name the interface: {why}");
-    }
+    let pair = runtime.block_on(async { open_pair(&interface) }).map_err(|error| {
+        assert!(error.contains(&interface), "the error does not name the interface: {error}");
+        why_not(&interface, &error)
+    });
     let Some((mut sender, mut receiver)) = common::or_skip(
         pair,
         &format!("SocketCAN interface {interface}"),
         "DRESSFORM_REQUIRE_SOCKETCAN",
     ) else {
+        eprintln!(
+            "the SocketCAN runtime test did not run: nothing was sent on {interface} \
+             (DRESSFORM_REQUIRE_SOCKETCAN=1 makes this a failure)"
+        );
         return;
     };
     let packet = Packet::broadcast(Message::Sync(Sync { duration_ms: 1234 }));
