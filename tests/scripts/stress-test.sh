@@ -4,11 +4,16 @@
 # Real-time tests (ptys, the e-stop, liveness, a stopped simulator) must pass here too. Not
 # part of CI.
 #
-#   tests/scripts/stress-test.sh [runs]     # default 1; the README reports 3 in a row
+#   tests/scripts/stress-test.sh [runs]             # default 1; the README reports 3 in a row
+#   tests/scripts/stress-test.sh [runs] FILTER...   # only the root tests matching a filter,
+#                                                   # e.g. `3 controller` (every real-time case
+#                                                   # of the link: e-stop, claim, liveness, ptys)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
 runs=${1:-1}
+shift || true
+filters=("$@")
 hogs=4
 # The simulated form stopped mid-move (SIGSTOP for 0.5, 1.5 and 2.5 s) this many times per
 # stop and link (tests/controller_liveness.rs; 2 without the script).
@@ -32,10 +37,15 @@ for run in $(seq 1 "$runs"); do
         sh -c 'while :; do :; done' &
         pids+=("$!")
     done
-    echo "== run $run of $runs: cargo test --workspace with $hogs CPU-bound processes" \
-        "($DRESSFORM_STALL_TRIES tries per simulator stop)"
+    echo "== run $run of $runs: cargo test ${filters[*]:---workspace} with $hogs CPU-bound" \
+        "processes ($DRESSFORM_STALL_TRIES tries per simulator stop)"
     start=$(date +%s)
-    if ! cargo test --workspace --no-fail-fast; then
+    if [ ${#filters[@]} -eq 0 ]; then
+        tests=(cargo test --workspace --no-fail-fast)
+    else
+        tests=(cargo test --test main --no-fail-fast -- "${filters[@]}")
+    fi
+    if ! "${tests[@]}"; then
         echo "== run $run FAILED after $(( $(date +%s) - start )) s"
         exit 1
     fi
