@@ -484,3 +484,67 @@ fn special_files_are_refused() {
     std::os::unix::fs::symlink(&target, &link).unwrap();
     assert_eq!(dressform(&["info", link.to_str().unwrap()]).0, 0);
 }
+
+/// The reference form's rings, each with `girth` as the mannequin's: a set-point file that
+/// moves nothing.
+fn girths_only(girth: f64) -> String {
+    let form = form_description::reference();
+    let girths: serde_json::Map<String, serde_json::Value> =
+        form.rings.iter().map(|r| (r.name.clone(), girth.into())).collect();
+    serde_json::json!({
+        "format": "dressform-setpoints/1", "form": "reference", "positions_mm": {},
+        "target_girths_mm": girths,
+    })
+    .to_string()
+}
+
+/// Issue 29: numbers such as 1e308 in set-points, profiles and forms were printed with 309
+/// digits and the reason cut off; they are shown short, the whole reason on the line.
+#[test]
+fn huge_numbers_in_files_are_shown_short() {
+    let dir = tempfile::tempdir().unwrap();
+    // Set-points.
+    let file = write(dir.path(), "setpoints.json", girths_only(-1e308));
+    let (code, _, stderr) = dressform_within(&["drive", file.to_str().unwrap(), "--sim"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert_one_clean_line(&stderr);
+    assert!(
+        stderr.contains(": -1e308 is not a girth in mm (above 0, at most 31415.9)"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("more characters"), "{stderr}");
+    // Profiles.
+    let profiles = serde_json::json!({
+        "format": "dressform-profiles/1", "frame": "canonical", "axis_x": 1e308, "rays": 360,
+        "preserve": "tape",
+        "levels": { "chest_mm": 1224.0, "waist_mm": 1049.0, "hip_mm": 868.0 },
+        "landmarks": {
+            "height_mm": 1700.0, "crotch_mm": 789.0, "ankle_mm": 112.0,
+            "left_armpit_mm": 1275.0, "right_armpit_mm": 1261.0, "neck_mm": 1467.0,
+            "centre_x_mm": -1.3,
+            "left_armhole": { "armpit_mm": [162.0, 2.0, 1275.0],
+                "shoulder_point_mm": [183.0, 19.0, 1392.0], "normal": [0.98, 0.0, -0.18] },
+            "right_armhole": { "armpit_mm": [-172.0, 34.0, 1261.0],
+                "shoulder_point_mm": [-191.0, 23.0, 1387.0], "normal": [-0.99, 0.0, -0.15] },
+        },
+        "layers": [],
+    });
+    let file = write(dir.path(), "profiles.json", profiles.to_string());
+    let out = dir.path().join("out.json");
+    let (code, _, stderr) =
+        dressform_within(&["setpoints", file.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert_one_clean_line(&stderr);
+    assert!(stderr.contains("axis_x: 1e308 is not within ±5000 mm"), "{stderr}");
+    assert!(!stderr.contains("more characters"), "{stderr}");
+    // Forms: every problem on its line, whole.
+    let toml = form_description::REFERENCE_TOML
+        .replacen("stroke_mm = 25.0", "stroke_mm = 1e308", 1)
+        .replacen("height_mm = ", "height_mm = -1e308 # ", 1);
+    let form = write(dir.path(), "form.toml", toml);
+    let (code, _, stderr) = dressform_within(&["form", "show", "--form", form.to_str().unwrap()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("`stroke_mm` = 1e308 must be in 0.01..=655.34"), "{stderr}");
+    assert!(stderr.contains("`height_mm` = -1e308 must be a height above the floor"), "{stderr}");
+    assert!(stderr.lines().all(|l| l.len() < 200) && !stderr.contains("more characters"));
+}
