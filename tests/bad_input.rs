@@ -548,3 +548,19 @@ fn huge_numbers_in_files_are_shown_short() {
     assert!(stderr.contains("`height_mm` = -1e308 must be a height above the floor"), "{stderr}");
     assert!(stderr.lines().all(|l| l.len() < 200) && !stderr.contains("more characters"));
 }
+
+/// Issue 29: the exit-3 summary of a form that could not take the shape was cut mid-number
+/// ("(6... (26 more characters)"); it lists the rings furthest off and ends "and N more".
+#[test]
+fn a_long_shape_summary_ends_with_how_many_more() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "setpoints.json", girths_only(5000.0));
+    let (code, _, stderr) = dressform_within(&["drive", file.to_str().unwrap(), "--sim"]);
+    assert_eq!(code, 3, "{stderr}");
+    assert_one_clean_line(&stderr);
+    assert!(stderr.contains("could not take the shape (tolerance 5 mm): "), "{stderr}");
+    assert!(!stderr.contains("more characters"), "{stderr}");
+    let rings = form_description::reference().rings.len();
+    let shown = stderr.matches(" mm wanted, ").count();
+    assert!(stderr.trim_end().ends_with(&format!(" and {} more", rings - shown)), "{stderr}");
+}
