@@ -564,3 +564,58 @@ fn a_long_shape_summary_ends_with_how_many_more() {
     let shown = stderr.matches(" mm wanted, ").count();
     assert!(stderr.trim_end().ends_with(&format!(" and {} more", rings - shown)), "{stderr}");
 }
+
+/// Issue 29: `--slower 1e308` overflowed the move's duration (exit 1, "the move needs
+/// 18446744073709551615 ms"); a factor too large for the move is bad input (exit 2), and
+/// the message gives the allowed range, from the longest SYNC (65535 ms).
+#[test]
+fn slower_than_a_sync_can_carry_is_refused_with_the_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let chest = serde_json::json!({
+        "format": "dressform-setpoints/1", "form": "reference",
+        "positions_mm": { "chest-front": 30.0 },
+    });
+    let file = write(dir.path(), "chest.json", chest.to_string());
+    let file = file.to_str().unwrap();
+    for slower in ["1e308", "65536", "inf", "NaN", "0.5"] {
+        let (code, _, stderr) = dressform_within(&["drive", file, "--sim", "--slower", slower]);
+        assert_eq!(code, 2, "{slower}: {stderr}");
+        assert_one_clean_line(&stderr);
+        assert!(stderr.contains(&format!("--slower: {slower} is not in [1, 65535]")), "{stderr}");
+    }
+    // Within the SYNC's range but too slow for this move: refused before the SYNC, with the
+    // range for the move.
+    let (code, _, stderr) = dressform_within(&["drive", file, "--sim", "--slower", "60000"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert_one_clean_line(&stderr);
+    assert!(stderr.contains("more than a SYNC can carry (65535 ms)"), "{stderr}");
+    assert!(stderr.contains("so --slower can be 1 to "), "{stderr}");
+}
+
+/// Issue 29: the other numbers `drive` takes are refused (exit 2) with one line naming the
+/// option and its range: NaN, infinities, negative and huge values.
+#[test]
+fn numeric_drive_options_name_their_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "setpoints.json", girths_only(900.0));
+    let file = file.to_str().unwrap();
+    for (option, value, expected) in [
+        ("--tolerance", "1e308", "--tolerance: 1e308 is not in (0, 655.34] mm"),
+        ("--tolerance", "NaN", "--tolerance: NaN is not in (0, 655.34] mm"),
+        ("--tolerance", "0", "--tolerance: 0 is not in (0, 655.34] mm"),
+        ("--duration", "1e308", "--duration: 1e308 is not in [0, 65.535] s"),
+        ("--duration", "-inf", "--duration: -inf is not in [0, 65.535] s"),
+        ("--girth-tolerance", "-1", "--girth-tolerance: -1 is not in [0, inf) mm"),
+        ("--girth-tolerance", "inf", "--girth-tolerance: inf is not in [0, inf) mm"),
+    ] {
+        let option_value = format!("{option}={value}");
+        let (code, _, stderr) = dressform_within(&["drive", file, "--sim", &option_value]);
+        assert_eq!(code, 2, "{option_value}: {stderr}");
+        assert_one_clean_line(&stderr);
+        assert!(stderr.contains(expected), "{option_value}: {stderr}");
+    }
+    // `run`'s smoothing passes: a huge count would run for hours.
+    let (code, _, stderr) = dressform_within(&["run", "scan.obj", "--sim", "--smooth", "1000000"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("'--smooth <SMOOTH>': 1000000 is not in 0..=100"), "{stderr}");
+}
