@@ -619,3 +619,55 @@ fn numeric_drive_options_name_their_range() {
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("'--smooth <SMOOTH>': 1000000 is not in 0..=100"), "{stderr}");
 }
+
+/// Issue 29: `model sample --beta 1e9` wrote a body 1e11 mm tall, `1e308` one with `inf`
+/// coordinates (exit 0); betas beyond 5 standard deviations are refused (exit 2), and nothing
+/// is written.
+#[test]
+fn betas_beyond_five_sigma_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let body = dir.path().join("body.obj");
+    let body = body.to_str().unwrap();
+    for beta in ["1e9", "1e308", "-5.5", "0,0,NaN"] {
+        let arg = format!("--beta={beta}");
+        let (code, _, stderr) = dressform_within(&["model", "sample", &arg, "-o", body]);
+        assert_eq!(code, 2, "{beta}: {stderr}");
+        assert_one_clean_line(&stderr);
+        assert!(stderr.contains("is not in [-5, 5] standard deviations"), "{stderr}");
+        assert!(!Path::new(body).exists(), "{beta}: a body was written");
+    }
+    let (code, _, stderr) = dressform_within(&["model", "sample", "--beta=5,-5", "-o", body]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(dressform(&["info", body]).0, 0, "the body at 5 sigma is one `info` reads");
+}
+
+/// A body model file whose vertices are not finite is refused: `model sample` never writes
+/// NaN or infinite coordinates.
+#[test]
+fn a_body_model_with_non_finite_vertices_is_refused() {
+    use dressform::body_model::{BodyModel, file};
+    let dir = tempfile::tempdir().unwrap();
+    let mut model = BodyModel::builtin();
+    model.mean[7].z = f64::NAN;
+    let mut glb = file::to_bytes(&model);
+    // The accessor's bounds become `null`: make them numbers (as long, for the chunk's
+    // length), so that only the vertex data is wrong.
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let json = &mut glb[20..20 + json_len];
+    while let Some(at) = json.windows(4).position(|w| w == b"null") {
+        json[at..at + 4].copy_from_slice(b"0   ");
+    }
+    let path = write(dir.path(), "model.glb", glb);
+    let body = dir.path().join("body.obj");
+    let (code, _, stderr) = dressform_within(&[
+        "model",
+        "sample",
+        "--model",
+        path.to_str().unwrap(),
+        "-o",
+        body.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("model.glb: POSITION of vertex 7 is not finite"), "{stderr}");
+    assert!(!body.exists());
+}
