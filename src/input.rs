@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 
 use serde::de::DeserializeOwned;
 
+use crate::messages;
+
 /// Why an input file cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum InputError {
@@ -60,15 +62,11 @@ pub fn check(path: &Path, problems: Result<(), Vec<String>>) -> Result<(), Input
     problems.map_err(|problems| InputError::Invalid { path: path.to_path_buf(), problems })
 }
 
-/// How many problems a message lists.
-const PROBLEMS_SHOWN: usize = 3;
-
-/// `problems` for a message: all of a few, or how many and the first ones.
+/// `problems` for a message: the one, or how many and the first ones (see
+/// [`messages::separated`]).
 fn summary(problems: &[String]) -> String {
-    let first = problems[..problems.len().min(PROBLEMS_SHOWN)].join("; ");
-    if problems.len() <= PROBLEMS_SHOWN {
-        first
-    } else {
-        format!("{} problems, the first {PROBLEMS_SHOWN}: {first}", problems.len())
+    match problems {
+        [one] => one.clone(),
+        _ => format!("{} problems: {}", problems.len(), messages::separated(problems, "; ")),
     }
 }

@@ -1,9 +1,9 @@
 //! How dressform words a problem: one line per problem, at most [`MAX_LINE`] characters,
-//! control characters escaped, long lists cut to their first few items ("and N more"), numbers
-//! in a readable precision. Whatever a file or a flag contains, the message stays readable and
+//! control characters escaped, long lists cut after an item ("a, b and N more"), numbers
+//! short (`1e308`). Whatever a file or a flag contains, the message stays readable and
 //! cannot move the cursor, recolour the terminal or fill the screen.
 
-use std::fmt::{self, Display};
+use std::fmt::Display;
 
 /// The longest line a message may have (characters): two lines of a terminal.
 pub const MAX_LINE: usize = 200;
@@ -67,52 +67,44 @@ fn needs_escape(c: char) -> bool {
         || matches!(c, '\u{200b}'..='\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
 }
 
-/// The first [`LIST_ITEMS`] of `items`, comma-separated, then "and N more".
+/// How many characters a list may take in a message: [`MAX_LINE`] less room for what the
+/// message says before it (a file name, a lead-in such as "positions outside the stroke: ").
+pub const LIST_CHARS: usize = 130;
+
+/// `items` for a message, comma-separated (see [`separated`]): `a, b, c and 7 more`.
 pub fn list<T: Display>(items: impl IntoIterator<Item = T>) -> String {
-    let mut shown = Vec::new();
-    let mut more = 0usize;
+    separated(items, ", ")
+}
+
+/// The first items of `items` joined by `separator`: at most [`LIST_ITEMS`], and no more
+/// than fit in [`LIST_CHARS`] (the first always shows), then "and N more" for the rest. A
+/// long list ends at an item, never in the middle of one.
+pub fn separated<T: Display>(items: impl IntoIterator<Item = T>, separator: &str) -> String {
+    let mut shown = String::new();
+    let (mut count, mut chars, mut more) = (0, 0, 0usize);
     for item in items {
-        if shown.len() < LIST_ITEMS {
-            shown.push(item.to_string());
-        } else {
-            more += 1;
+        if more == 0 && count < LIST_ITEMS {
+            let item = item.to_string();
+            let sep = if count == 0 { "" } else { separator };
+            let width = sep.chars().count() + item.chars().count();
+            if count == 0 || chars + width <= LIST_CHARS {
+                shown.push_str(sep);
+                shown.push_str(&item);
+                (count, chars) = (count + 1, chars + width);
+                continue;
+            }
         }
+        more += 1;
     }
-    let mut s = shown.join(", ");
     if more > 0 {
-        s.push_str(&format!(" and {more} more"));
+        shown.push_str(&format!(" and {more} more"));
     }
-    s
+    shown
 }
 
-/// A number as a message shows it: up to 6 significant digits, in exponent form when very
-/// large or small (`1e300`, not three hundred digits).
-pub fn number(x: f64) -> Number {
-    Number(x)
-}
-
-/// See [`number`].
-#[derive(Debug, Clone, Copy)]
-pub struct Number(pub f64);
-
-impl Display for Number {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let x = self.0;
-        // Plain notation covers body sizes in any unit, from 0.001 mm to 10 km.
-        if x == 0.0 || !x.is_finite() || (1e-3..1e7).contains(&x.abs()) {
-            let digits = 5usize.saturating_sub(x.abs().log10().floor().max(0.0) as usize);
-            let s = format!("{x:.digits$}");
-            let s =
-                if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.') } else { &s };
-            f.write_str(if s == "-0" { "0" } else { s })
-        } else {
-            let s = format!("{x:.5e}");
-            let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
-            let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
-            write!(f, "{mantissa}e{exponent}")
-        }
-    }
-}
+/// Numbers as messages show them (`1e308`, not 309 digits): the one formatter of the workspace,
+/// in the lowest crate whose messages echo numbers from files (form descriptions).
+pub use form_description::{Number, number};
 
 /// `message` made safe to print: each line escaped (see [`quote`]) and cut to [`MAX_LINE`]
 /// characters, at most [`MAX_LINES`] lines. The command line passes every error and warning
@@ -160,19 +152,21 @@ mod tests {
     fn long_lists_show_the_first_few() {
         assert_eq!(list(["a", "b"]), "a, b");
         assert_eq!(list(0..100_000), "0, 1, 2, 3, 4 and 99995 more");
+        assert_eq!(separated(["a, b", "c"], "; "), "a, b; c");
     }
 
     #[test]
-    fn numbers_are_short() {
-        let shown: Vec<String> = [0.0, -0.0, 1.7, 1700.0, 1234.56789, 0.0125, 1e300, -2.5e-9, 1e7]
-            .map(|x| number(x).to_string())
-            .into();
+    fn long_items_end_the_list_at_an_item() {
+        let items: Vec<String> = (0..30).map(|i| format!("ring-{i} (1234567 mm wanted)")).collect();
+        let shown = list(&items);
         assert_eq!(
             shown,
-            ["0", "0", "1.7", "1700", "1234.57", "0.0125", "1e300", "-2.5e-9", "1e7"]
+            format!("{}, {}, {}, {} and 26 more", items[0], items[1], items[2], items[3])
         );
-        assert_eq!(number(f64::NAN).to_string(), "NaN");
-        assert_eq!(number(f64::NEG_INFINITY).to_string(), "-inf");
+        assert!(shown.chars().count() <= LIST_CHARS + " and 26 more".len());
+        // One item longer than the budget still shows, whole.
+        let long = "x".repeat(LIST_CHARS + 10);
+        assert_eq!(list([long.as_str(), "y"]), format!("{long} and 1 more"));
     }
 
     #[test]

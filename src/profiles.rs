@@ -31,6 +31,7 @@
 use crate::input::{self, InputError};
 use crate::mannequin::{Layer, Mannequin};
 use crate::measure::Levels;
+use crate::messages;
 use crate::regions::{Landmarks, Region};
 use crate::symmetry::Preserve;
 use serde::{Deserialize, Serialize};
@@ -43,6 +44,9 @@ pub const FORMAT: &str = "dressform-profiles/1";
 /// adult fits within 2.5 m, so 5 m leaves room for any offset and still refuses garbage
 /// (1e308, a file in metres read as millimetres is fine, one in micrometres is not).
 pub const MAX_COORDINATE_MM: f64 = 5000.0;
+
+/// The largest girth a file may give, mm: a circle of radius [`MAX_COORDINATE_MM`].
+pub const MAX_GIRTH_MM: f64 = MAX_COORDINATE_MM * std::f64::consts::TAU;
 
 /// The fewest layers of a region the form needs: rings are placed between two layers.
 const MIN_LAYERS: usize = 2;
@@ -136,6 +140,7 @@ impl Profiles {
         }
         let mut place = |field: String, value: f64| {
             if !(value.is_finite() && value.abs() <= MAX_COORDINATE_MM) {
+                let value = messages::number(value);
                 problems.push(format!("{field}: {value} is not within ±{MAX_COORDINATE_MM} mm"));
             }
         };
@@ -190,9 +195,8 @@ impl Profiles {
                 ("tape_girth", layer.tape_girth),
                 ("contour_length", layer.contour_length),
             ] {
-                if !(girth.is_finite()
-                    && (0.0..=MAX_COORDINATE_MM * std::f64::consts::TAU).contains(&girth))
-                {
+                if !(girth.is_finite() && (0.0..=MAX_GIRTH_MM).contains(&girth)) {
+                    let girth = messages::number(girth);
                     problems.push(format!("layers[{i}].{name}: {girth} is not a girth in mm"));
                 }
             }
@@ -231,7 +235,8 @@ impl Profiles {
                 if above.z < below.z {
                     problems.push(format!(
                         "layers[{k}].z: {} is below the {name} layer before it ({}): layers go bottom to top",
-                        above.z, below.z
+                        messages::number(above.z),
+                        messages::number(below.z)
                     ));
                 }
             }

@@ -18,10 +18,11 @@
 //!   each ring's reached girth with it (`fitting::outcome`).
 //!
 //! Loading refuses an id given twice (JSON parsers would keep the last silently), an unknown
-//! actuator or ring, a non-finite value, a girth that is not positive, or another form's
-//! name, naming the file and the field or actuator. [`SetPoints::check`] then refuses positions outside
-//! `[0, stroke]` with the list of offenders, or clamps them into the stroke and reports them
-//! (`--clamp`); only a [`Checked`] set of targets can be driven.
+//! actuator or ring, a non-finite value, a girth that is not positive or beyond
+//! [`MAX_GIRTH_MM`], or another form's name, naming the file and the field or actuator.
+//! [`SetPoints::check`] then refuses positions outside `[0, stroke]` with the list of
+//! offenders, or clamps them into the stroke and reports them (`--clamp`); only a [`Checked`]
+//! set of targets can be driven.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -33,6 +34,7 @@ use serde::{Deserialize, Serialize};
 use crate::input::{self, InputError};
 use crate::messages;
 use crate::output::{WriteError, write_atomically};
+use crate::profiles::MAX_GIRTH_MM;
 use crate::safety::SafeTarget;
 
 /// The `format` of the files this module reads and writes.
@@ -91,12 +93,12 @@ fn list(offending: &[(String, f64, f64)]) -> String {
     }))
 }
 
-/// An actuator id as messages show it (escaped, cut: ids come from files).
+/// An actuator id or ring name as messages show it (escaped, cut: they come from files).
 fn shown(id: &str) -> String {
     messages::quote(id.as_bytes(), ID_SHOWN)
 }
 
-/// How many characters of an actuator id a message shows.
+/// How many characters of an actuator id or ring name a message shows.
 const ID_SHOWN: usize = 40;
 
 /// Set-points checked against a form: every target lies within its actuator's stroke.
@@ -145,7 +147,8 @@ impl SetPoints {
     }
 
     /// Every problem with using these set-points on `form`: another form's name, unknown
-    /// actuator ids or rings, non-finite values, girths that are not positive.
+    /// actuator ids or rings, non-finite values, girths that are not positive or larger than
+    /// [`MAX_GIRTH_MM`].
     pub fn validate(&self, form: &FormDescription) -> Result<(), Vec<String>> {
         let mut problems = Vec::new();
         if self.form != form.name {
@@ -158,14 +161,22 @@ impl SetPoints {
             if form.actuator(id).is_none() {
                 problems.push(format!("positions_mm.{}: the form has no actuator", shown(id)));
             } else if !mm.is_finite() {
-                problems.push(format!("positions_mm.{}: {mm} is not a finite number", shown(id)));
+                problems.push(format!(
+                    "positions_mm.{}: {} is not a finite number",
+                    shown(id),
+                    messages::number(mm)
+                ));
             }
         }
         for (ring, &mm) in &self.target_girths_mm {
+            let name = shown(ring);
             if !form.rings.iter().any(|r| &r.name == ring) {
-                problems.push(format!("target_girths_mm.{ring}: the form has no ring \"{ring}\""));
-            } else if !(mm.is_finite() && mm > 0.0) {
-                problems.push(format!("target_girths_mm.{ring}: {mm} is not a positive girth"));
+                problems.push(format!("target_girths_mm.{name}: the form has no ring \"{name}\""));
+            } else if !(mm.is_finite() && mm > 0.0 && mm <= MAX_GIRTH_MM) {
+                let (mm, max) = (messages::number(mm), messages::number(MAX_GIRTH_MM));
+                problems.push(format!(
+                    "target_girths_mm.{name}: {mm} is not a girth in mm (above 0, at most {max})"
+                ));
             }
         }
         if problems.is_empty() { Ok(()) } else { Err(problems) }

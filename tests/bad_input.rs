@@ -484,3 +484,190 @@ fn special_files_are_refused() {
     std::os::unix::fs::symlink(&target, &link).unwrap();
     assert_eq!(dressform(&["info", link.to_str().unwrap()]).0, 0);
 }
+
+/// The reference form's rings, each with `girth` as the mannequin's: a set-point file that
+/// moves nothing.
+fn girths_only(girth: f64) -> String {
+    let form = form_description::reference();
+    let girths: serde_json::Map<String, serde_json::Value> =
+        form.rings.iter().map(|r| (r.name.clone(), girth.into())).collect();
+    serde_json::json!({
+        "format": "dressform-setpoints/1", "form": "reference", "positions_mm": {},
+        "target_girths_mm": girths,
+    })
+    .to_string()
+}
+
+/// Issue 29: numbers such as 1e308 in set-points, profiles and forms were printed with 309
+/// digits and the reason cut off; they are shown short, the whole reason on the line.
+#[test]
+fn huge_numbers_in_files_are_shown_short() {
+    let dir = tempfile::tempdir().unwrap();
+    // Set-points.
+    let file = write(dir.path(), "setpoints.json", girths_only(-1e308));
+    let (code, _, stderr) = dressform_within(&["drive", file.to_str().unwrap(), "--sim"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert_one_clean_line(&stderr);
+    assert!(
+        stderr.contains(": -1e308 is not a girth in mm (above 0, at most 31415.9)"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("more characters"), "{stderr}");
+    // Profiles.
+    let profiles = serde_json::json!({
+        "format": "dressform-profiles/1", "frame": "canonical", "axis_x": 1e308, "rays": 360,
+        "preserve": "tape",
+        "levels": { "chest_mm": 1224.0, "waist_mm": 1049.0, "hip_mm": 868.0 },
+        "landmarks": {
+            "height_mm": 1700.0, "crotch_mm": 789.0, "ankle_mm": 112.0,
+            "left_armpit_mm": 1275.0, "right_armpit_mm": 1261.0, "neck_mm": 1467.0,
+            "centre_x_mm": -1.3,
+            "left_armhole": { "armpit_mm": [162.0, 2.0, 1275.0],
+                "shoulder_point_mm": [183.0, 19.0, 1392.0], "normal": [0.98, 0.0, -0.18] },
+            "right_armhole": { "armpit_mm": [-172.0, 34.0, 1261.0],
+                "shoulder_point_mm": [-191.0, 23.0, 1387.0], "normal": [-0.99, 0.0, -0.15] },
+        },
+        "layers": [],
+    });
+    let file = write(dir.path(), "profiles.json", profiles.to_string());
+    let out = dir.path().join("out.json");
+    let (code, _, stderr) =
+        dressform_within(&["setpoints", file.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert_one_clean_line(&stderr);
+    assert!(stderr.contains("axis_x: 1e308 is not within ±5000 mm"), "{stderr}");
+    assert!(!stderr.contains("more characters"), "{stderr}");
+    // Forms: every problem on its line, whole.
+    let toml = form_description::REFERENCE_TOML
+        .replacen("stroke_mm = 25.0", "stroke_mm = 1e308", 1)
+        .replacen("height_mm = ", "height_mm = -1e308 # ", 1);
+    let form = write(dir.path(), "form.toml", toml);
+    let (code, _, stderr) = dressform_within(&["form", "show", "--form", form.to_str().unwrap()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("`stroke_mm` = 1e308 must be in 0.01..=655.34"), "{stderr}");
+    assert!(stderr.contains("`height_mm` = -1e308 must be a height above the floor"), "{stderr}");
+    assert!(stderr.lines().all(|l| l.len() < 200) && !stderr.contains("more characters"));
+}
+
+/// Issue 29: the exit-3 summary of a form that could not take the shape was cut mid-number
+/// ("(6... (26 more characters)"); it lists the rings furthest off and ends "and N more".
+#[test]
+fn a_long_shape_summary_ends_with_how_many_more() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "setpoints.json", girths_only(5000.0));
+    let (code, _, stderr) = dressform_within(&["drive", file.to_str().unwrap(), "--sim"]);
+    assert_eq!(code, 3, "{stderr}");
+    assert_one_clean_line(&stderr);
+    assert!(stderr.contains("could not take the shape (tolerance 5 mm): "), "{stderr}");
+    assert!(!stderr.contains("more characters"), "{stderr}");
+    let rings = form_description::reference().rings.len();
+    let shown = stderr.matches(" mm wanted, ").count();
+    assert!(stderr.trim_end().ends_with(&format!(" and {} more", rings - shown)), "{stderr}");
+}
+
+/// Issue 29: `--slower 1e308` overflowed the move's duration (exit 1, "the move needs
+/// 18446744073709551615 ms"); a factor too large for the move is bad input (exit 2), and
+/// the message gives the allowed range, from the longest SYNC (65535 ms).
+#[test]
+fn slower_than_a_sync_can_carry_is_refused_with_the_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let chest = serde_json::json!({
+        "format": "dressform-setpoints/1", "form": "reference",
+        "positions_mm": { "chest-front": 30.0 },
+    });
+    let file = write(dir.path(), "chest.json", chest.to_string());
+    let file = file.to_str().unwrap();
+    for slower in ["1e308", "65536", "inf", "NaN", "0.5"] {
+        let (code, _, stderr) = dressform_within(&["drive", file, "--sim", "--slower", slower]);
+        assert_eq!(code, 2, "{slower}: {stderr}");
+        assert_one_clean_line(&stderr);
+        assert!(stderr.contains(&format!("--slower: {slower} is not in [1, 65535]")), "{stderr}");
+    }
+    // Within the SYNC's range but too slow for this move: refused before the SYNC, with the
+    // range for the move.
+    let (code, _, stderr) = dressform_within(&["drive", file, "--sim", "--slower", "60000"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert_one_clean_line(&stderr);
+    assert!(stderr.contains("more than a SYNC can carry (65535 ms)"), "{stderr}");
+    assert!(stderr.contains("so --slower can be 1 to "), "{stderr}");
+}
+
+/// Issue 29: the other numbers `drive` takes are refused (exit 2) with one line naming the
+/// option and its range: NaN, infinities, negative and huge values.
+#[test]
+fn numeric_drive_options_name_their_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "setpoints.json", girths_only(900.0));
+    let file = file.to_str().unwrap();
+    for (option, value, expected) in [
+        ("--tolerance", "1e308", "--tolerance: 1e308 is not in (0, 655.34] mm"),
+        ("--tolerance", "NaN", "--tolerance: NaN is not in (0, 655.34] mm"),
+        ("--tolerance", "0", "--tolerance: 0 is not in (0, 655.34] mm"),
+        ("--duration", "1e308", "--duration: 1e308 is not in [0, 65.535] s"),
+        ("--duration", "-inf", "--duration: -inf is not in [0, 65.535] s"),
+        ("--girth-tolerance", "-1", "--girth-tolerance: -1 is not in [0, inf) mm"),
+        ("--girth-tolerance", "inf", "--girth-tolerance: inf is not in [0, inf) mm"),
+    ] {
+        let option_value = format!("{option}={value}");
+        let (code, _, stderr) = dressform_within(&["drive", file, "--sim", &option_value]);
+        assert_eq!(code, 2, "{option_value}: {stderr}");
+        assert_one_clean_line(&stderr);
+        assert!(stderr.contains(expected), "{option_value}: {stderr}");
+    }
+    // `run`'s smoothing passes: a huge count would run for hours.
+    let (code, _, stderr) = dressform_within(&["run", "scan.obj", "--sim", "--smooth", "1000000"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("'--smooth <SMOOTH>': 1000000 is not in 0..=100"), "{stderr}");
+}
+
+/// Issue 29: `model sample --beta 1e9` wrote a body 1e11 mm tall, `1e308` one with `inf`
+/// coordinates (exit 0); betas beyond 5 standard deviations are refused (exit 2), and nothing
+/// is written.
+#[test]
+fn betas_beyond_five_sigma_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let body = dir.path().join("body.obj");
+    let body = body.to_str().unwrap();
+    for beta in ["1e9", "1e308", "-5.5", "0,0,NaN"] {
+        let arg = format!("--beta={beta}");
+        let (code, _, stderr) = dressform_within(&["model", "sample", &arg, "-o", body]);
+        assert_eq!(code, 2, "{beta}: {stderr}");
+        assert_one_clean_line(&stderr);
+        assert!(stderr.contains("is not in [-5, 5] standard deviations"), "{stderr}");
+        assert!(!Path::new(body).exists(), "{beta}: a body was written");
+    }
+    let (code, _, stderr) = dressform_within(&["model", "sample", "--beta=5,-5", "-o", body]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(dressform(&["info", body]).0, 0, "the body at 5 sigma is one `info` reads");
+}
+
+/// A body model file whose vertices are not finite is refused: `model sample` never writes
+/// NaN or infinite coordinates.
+#[test]
+fn a_body_model_with_non_finite_vertices_is_refused() {
+    use dressform::body_model::{BodyModel, file};
+    let dir = tempfile::tempdir().unwrap();
+    let mut model = BodyModel::builtin();
+    model.mean[7].z = f64::NAN;
+    let mut glb = file::to_bytes(&model);
+    // The accessor's bounds become `null`: make them numbers (as long, for the chunk's
+    // length), so that only the vertex data is wrong.
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let json = &mut glb[20..20 + json_len];
+    while let Some(at) = json.windows(4).position(|w| w == b"null") {
+        json[at..at + 4].copy_from_slice(b"0   ");
+    }
+    let path = write(dir.path(), "model.glb", glb);
+    let body = dir.path().join("body.obj");
+    let (code, _, stderr) = dressform_within(&[
+        "model",
+        "sample",
+        "--model",
+        path.to_str().unwrap(),
+        "-o",
+        body.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("model.glb: POSITION of vertex 7 is not finite"), "{stderr}");
+    assert!(!body.exists());
+}

@@ -258,6 +258,11 @@ pub struct Sync {
     pub duration_ms: u16,
 }
 
+impl Sync {
+    /// The longest move a SYNC can ask for, ms (`duration_ms` is a `u16` on the wire).
+    pub const MAX_DURATION_MS: u16 = u16::MAX;
+}
+
 /// `Emergency`: a node reports a fault or a warning.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Emergency {

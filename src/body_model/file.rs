@@ -601,6 +601,13 @@ pub fn from_bytes(bytes: &[u8]) -> Result<BodyModel, String> {
                 .ok_or(format!("morph target {c} has {} vertices, not {n}", 0))
         })
         .collect::<Result<Vec<_>, String>>()?;
+    // Finite values and |beta| <= MAX_BETA keep every body finite: nothing writes NaN or inf.
+    if let Some(v) = mean.iter().position(|p| !p.is_finite()) {
+        return Err(format!("POSITION of vertex {v} is not finite"));
+    }
+    if let Some(c) = components.iter().position(|d| d.iter().any(|p| !p.is_finite())) {
+        return Err(format!("morph target {c} has a coordinate that is not finite"));
+    }
     let skin = root.skins.first().ok_or("no skin")?;
     let bone_nodes: Vec<usize> = skin.joints.iter().map(|j| j.value()).collect();
     let mut parents = vec![None; bone_nodes.len()];

@@ -26,6 +26,11 @@ use crate::skinning::{self, SkinWeights};
 use glam::DVec3;
 use rayon::prelude::*;
 
+/// The largest |beta| a sampled body takes, standard deviations: beyond 5 sigma a normal
+/// population has fewer than 1 body in 1.7 million. Within it the built-in model's bodies are
+/// 1.1 to 2.3 m tall (every component at +5 or -5), people that `dressform info` reads.
+pub const MAX_BETA: f64 = 5.0;
+
 /// Vertices handed to one parallel task when evaluating the model.
 const VERTICES_PER_TASK: usize = 2048;
 

@@ -7,17 +7,22 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Duration;
 
+use dressform::controller::motion::MAX_SLOWER;
 use dressform::controller::simulated::SimConfig;
 use dressform::controller::{
-    Claim, DEFAULT_TOLERANCE_MM, DriveError, DriveOptions, DriveReport, LinkSpec, Progress,
-    SessionError, Transport, plan,
+    Claim, DEFAULT_TOLERANCE_MM, DriveError, DriveOptions, DriveReport, LinkSpec, MoveError,
+    Progress, SessionError, Transport, plan,
 };
 use dressform::fitting::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
+use dressform::messages;
 use dressform::setpoints::SetPoints;
+use firmware_protocol::Position;
+use firmware_protocol::message::Sync;
 use form_description::FormDescription;
+use std::ops::Bound;
 
-use super::Failure;
 use super::link::{self, FormArg, LinkArgs, runtime};
+use super::{Failure, within};
 
 /// The simulated form's options (with `--sim`).
 #[derive(Debug, Clone, Default, clap::Args)]
@@ -46,11 +51,7 @@ pub struct ShapeArgs {
 impl ShapeArgs {
     /// The tolerance, checked.
     pub fn girth_tolerance(&self) -> Result<f64, Failure> {
-        if self.girth_tolerance.is_finite() && self.girth_tolerance >= 0.0 {
-            Ok(self.girth_tolerance)
-        } else {
-            Err(Failure::bad_input("--girth-tolerance: must be a number of mm, 0 or more"))
-        }
+        within("--girth-tolerance", self.girth_tolerance, 0.0.., " mm")
     }
 
     /// Drive options with `--reset-faults`.
@@ -75,13 +76,15 @@ pub struct DriveArgs {
     /// the file.
     #[arg(long)]
     clamp: bool,
-    /// An actuator within this of its target has arrived, mm.
+    /// An actuator within this of its target has arrived, mm (above 0, at most the longest
+    /// stroke the wire carries: 655.34).
     #[arg(long, default_value_t = DEFAULT_TOLERANCE_MM)]
     tolerance: f64,
-    /// Move this many times slower than the shortest feasible move (≥ 1).
+    /// Move this many times slower than the shortest feasible move: 1 to 65535 (a SYNC lasts
+    /// at most 65535 ms, a move at least 1 ms), and no more than fits this move's SYNC.
     #[arg(long, default_value_t = 1.0)]
     slower: f64,
-    /// Make the move last at least this many seconds.
+    /// Make the move last at least this many seconds: 0 to 65.535 (the longest SYNC).
     #[arg(long, value_name = "SECONDS")]
     duration: Option<f64>,
     /// Print the report as JSON on standard output.
@@ -90,27 +93,29 @@ pub struct DriveArgs {
 }
 
 pub fn run(args: &DriveArgs) -> Result<(), Failure> {
+    // The options first: nothing is read or sent with one out of range.
+    let tolerance_mm = within(
+        "--tolerance",
+        args.tolerance,
+        (Bound::Excluded(0.0), Bound::Included(Position::MAX.mm())),
+        " mm",
+    )?;
+    let slower = within("--slower", args.slower, 1.0..=MAX_SLOWER, "")?;
+    let longest_s = f64::from(Sync::MAX_DURATION_MS) / 1000.0;
+    let min_duration = match args.duration {
+        Some(s) => Duration::from_secs_f64(within("--duration", s, 0.0..=longest_s, " s")?),
+        None => Duration::ZERO,
+    };
+    let girth_tolerance = args.shape.girth_tolerance()?;
     let form = args.form.load()?;
     let setpoints = SetPoints::load(&args.setpoints, &form).map_err(Failure::bad_input)?;
     let file = args.setpoints.display().to_string();
     // Refuse out-of-stroke files before touching the form.
     plan(&form, &setpoints, args.clamp).map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
-    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
-        return Err(Failure::bad_input("--tolerance: must be a positive number of mm"));
-    }
-    if !(args.slower.is_finite() && args.slower >= 1.0) {
-        return Err(Failure::bad_input("--slower: must be a number ≥ 1"));
-    }
-    let min_duration = match args.duration {
-        Some(s) if s.is_finite() && (0.0..=65.535).contains(&s) => Duration::from_secs_f64(s),
-        Some(_) => return Err(Failure::bad_input("--duration: must be 0..=65.535 seconds")),
-        None => Duration::ZERO,
-    };
-    let girth_tolerance = args.shape.girth_tolerance()?;
     let options = DriveOptions {
         clamp: args.clamp,
-        tolerance_mm: args.tolerance,
-        slower: args.slower,
+        tolerance_mm,
+        slower,
         min_duration,
         ..args.shape.options()
     };
@@ -219,7 +224,10 @@ const LOG_CHECK: Duration = Duration::from_millis(100);
 impl From<DriveError> for Failure {
     fn from(e: DriveError) -> Self {
         match e {
-            DriveError::OutOfStroke(_) => Failure::bad_input(e),
+            // Out of stroke, or a move longer than a SYNC carries: what was asked.
+            DriveError::OutOfStroke(_) | DriveError::Move(MoveError::TooLong { .. }) => {
+                Failure::bad_input(e)
+            }
             DriveError::NotReached(report) => {
                 print_table(&report);
                 Failure::other(DriveError::NotReached(report))
@@ -234,6 +242,7 @@ impl From<DriveError> for Failure {
 
 fn print_report(report: &DriveReport, shape: &ShapeOutcome, json: bool) -> Result<(), Failure> {
     for (id, asked, used) in &report.clamped {
+        let (asked, used) = (messages::number(*asked), messages::number(*used));
         errln!("warning: {id}: {asked} mm is outside the stroke, clamped to {used} mm");
     }
     for warning in &report.warnings {

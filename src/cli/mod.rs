@@ -43,14 +43,16 @@ mod slice;
 mod status;
 mod symmetrize;
 
-use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use clap::builder::{PossibleValue, PossibleValuesParser, RangedU64ValueParser, TypedValueParser};
 use clap::{Parser, Subcommand};
+use dressform::mesh::smooth;
 use dressform::messages;
 use dressform::scan::Scan;
 use dressform::scan::format::{Export, Format, Placement, UpAxis};
 use dressform::scan::frame::{Direction, FrameOptions, Units};
 use dressform::symmetry::Preserve;
 use std::io::{ErrorKind, Write};
+use std::ops::{Bound, RangeBounds};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Personalized symmetric mannequins from 3D body scans, and the robotic dress form they drive.
@@ -112,10 +114,15 @@ pub struct FrameArgs {
 /// Denoising before measuring.
 #[derive(Debug, Clone, clap::Args)]
 pub struct SmoothArgs {
-    /// Taubin smoothing passes applied to the scan before measuring (0: none). Scanner noise
-    /// otherwise inflates tape girths by several millimetres.
-    #[arg(long, default_value_t = dressform::mesh::smooth::DEFAULT_PASSES)]
+    /// Taubin smoothing passes applied to the scan before measuring, 0 (none) to 100. Scanner
+    /// noise otherwise inflates tape girths by several millimetres.
+    #[arg(long, default_value_t = smooth::DEFAULT_PASSES, value_parser = passes_parser())]
     smooth: usize,
+}
+
+/// `--smooth`: 0 to [`smooth::MAX_PASSES`] passes.
+fn passes_parser() -> RangedU64ValueParser<usize> {
+    RangedU64ValueParser::new().range(0..=smooth::MAX_PASSES as u64)
 }
 
 /// A parser for one of the library's plain enums (the library knows nothing of clap): each of
@@ -299,6 +306,31 @@ impl Failure {
     }
 }
 
+/// `value`, the number given for `option`, if it is finite and in `range`; else a one-line
+/// error (exit status 2) naming the option, the value and the range in `unit` (`" mm"`, or
+/// empty): `--slower: 1e308 is not in [1, 65535]`.
+fn within(
+    option: &str,
+    value: f64,
+    range: impl RangeBounds<f64>,
+    unit: &str,
+) -> Result<f64, Failure> {
+    if value.is_finite() && range.contains(&value) {
+        return Ok(value);
+    }
+    let end = |bound: Bound<&f64>, unbounded: &str| match bound {
+        Bound::Included(x) | Bound::Excluded(x) => messages::number(*x).to_string(),
+        Bound::Unbounded => unbounded.to_string(),
+    };
+    let open = if matches!(range.start_bound(), Bound::Included(_)) { "[" } else { "(" };
+    let close = if matches!(range.end_bound(), Bound::Included(_)) { "]" } else { ")" };
+    let (low, high) = (end(range.start_bound(), "-inf"), end(range.end_bound(), "inf"));
+    Err(Failure::bad_input(format!(
+        "{option}: {} is not in {open}{low}, {high}{close}{unit}",
+        messages::number(value)
+    )))
+}
+
 /// Runs the command `args` names.
 pub fn run(args: Args) -> Result<(), Failure> {
     match args.command {
@@ -363,4 +395,29 @@ fn progress_bar(json: bool, steps: u64) -> indicatif::ProgressBar {
     }
     bar.enable_steady_tick(std::time::Duration::from_millis(100));
     bar
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_out_of_range_name_the_option_and_the_range() {
+        let message = |r: Result<f64, Failure>| r.unwrap_err().message;
+        assert_eq!(
+            message(within("--slower", 1e308, 1.0..=65535.0, "")),
+            "--slower: 1e308 is not in [1, 65535]"
+        );
+        let positive = (Bound::Excluded(0.0), Bound::Included(655.34));
+        assert_eq!(
+            message(within("--tolerance", 0.0, positive, " mm")),
+            "--tolerance: 0 is not in (0, 655.34] mm"
+        );
+        assert_eq!(
+            message(within("--girth-tolerance", f64::INFINITY, 0.0.., " mm")),
+            "--girth-tolerance: inf is not in [0, inf) mm"
+        );
+        assert_eq!(within("--beta", -5.0, -5.0..=5.0, "").unwrap(), -5.0);
+        assert_eq!(within("--x", f64::NAN, .., "").unwrap_err().exit_code, 2);
+    }
 }

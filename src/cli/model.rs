@@ -1,7 +1,7 @@
 //! `dressform model build|info|sample`: the statistical body model (paper 3.1.1).
 
-use super::{Failure, progress_bar};
-use dressform::body_model::{self, BodyModel, BuildOptions, file};
+use super::{Failure, progress_bar, within};
+use dressform::body_model::{self, BodyModel, BuildOptions, MAX_BETA, file};
 use dressform::makehuman::MakeHuman;
 use dressform::output::write_atomically;
 use dressform::scan::{self, format::Format};
@@ -59,7 +59,8 @@ struct SampleArgs {
     /// A model file [default: the built-in model].
     #[arg(long)]
     model: Option<PathBuf>,
-    /// Shape coefficients in standard deviations, comma-separated (missing ones are 0).
+    /// Shape coefficients in standard deviations, comma-separated (missing ones are 0), each
+    /// within ±5 (`body_model::MAX_BETA`).
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     beta: Vec<f64>,
     /// The mesh to write (.obj, .ply or .stl; canonical frame, mm).
@@ -201,8 +202,8 @@ fn info(args: &InfoArgs) -> Result<(), Failure> {
 
 fn sample(args: &SampleArgs) -> Result<(), Failure> {
     let model = load(args.model.as_deref())?;
-    if let Some(b) = args.beta.iter().find(|b| !b.is_finite()) {
-        return Err(Failure::bad_input(format!("--beta: {b} is not a finite number")));
+    for &beta in &args.beta {
+        within("--beta", beta, -MAX_BETA..=MAX_BETA, " standard deviations")?;
     }
     if args.beta.len() > model.k() {
         return Err(Failure::bad_input(format!(

@@ -20,9 +20,9 @@ pub struct SliceArgs {
     json: bool,
     #[command(flatten)]
     frame: FrameArgs,
-    /// Taubin smoothing passes applied before cutting (default 0: the scan as it is; the
-    /// commands that measure use 8).
-    #[arg(long, default_value_t = 0)]
+    /// Taubin smoothing passes applied before cutting, 0 to 100 (default 0: the scan as it
+    /// is; the commands that measure use 8).
+    #[arg(long, default_value_t = 0, value_parser = super::passes_parser())]
     smooth: usize,
 }
 

@@ -146,7 +146,7 @@ pub enum DriveError {
     #[error(transparent)]
     Move(#[from] MoveError),
     /// Some actuators did not arrive within tolerance in time.
-    #[error("{} actuators not within tolerance after {} ms: {}", .0.actuators.iter().filter(|a| !a.within_tolerance).count(), .0.elapsed_ms, .0.actuators.iter().filter(|a| !a.within_tolerance).map(|a| a.id.as_str()).collect::<Vec<_>>().join(", "))]
+    #[error("{} actuators not within tolerance after {} ms: {}", .0.actuators.iter().filter(|a| !a.within_tolerance).count(), .0.elapsed_ms, crate::messages::list(.0.actuators.iter().filter(|a| !a.within_tolerance).map(|a| &a.id)))]
     NotReached(Box<DriveReport>),
 }
 

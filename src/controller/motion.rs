@@ -27,6 +27,7 @@ use tokio::time::Instant;
 
 use super::session::{Session, SessionError};
 use super::transport::Transport;
+use crate::messages::number;
 use crate::safety::SafeTarget;
 
 /// How many times a move resumes after node reboots before it fails.
@@ -111,9 +112,43 @@ pub enum MoveError {
         /// How many reboots.
         times: usize,
     },
-    /// No duration fits the protocol's 65.535 s.
-    #[error("the move needs {0} ms, more than a SYNC can carry (65535 ms)")]
-    TooLong(u64),
+    /// No duration fits a SYNC ([`Sync::MAX_DURATION_MS`]).
+    #[error("{}", too_long(*shortest_ms, *slower, *least_ms))]
+    TooLong {
+        /// The shortest duration at the actuators' limits, ms.
+        shortest_ms: u64,
+        /// How many times slower the move was asked to be.
+        slower: f64,
+        /// The least duration asked, ms.
+        least_ms: u64,
+    },
+}
+
+/// The largest [`MoveOptions::slower`] that can fit a SYNC at all: a move lasts at least
+/// 1 ms ([`shortest_duration_ms`] rounds up), a SYNC at most [`Sync::MAX_DURATION_MS`].
+pub const MAX_SLOWER: f64 = Sync::MAX_DURATION_MS as f64;
+
+/// Why a move does not fit a SYNC, and with `--slower` how slow it can be.
+fn too_long(shortest_ms: u64, slower: f64, least_ms: u64) -> String {
+    let max = Sync::MAX_DURATION_MS;
+    let limit = format!("more than a SYNC can carry ({max} ms)");
+    if shortest_ms > u64::from(max) {
+        format!(
+            "the move takes {shortest_ms} ms at the actuators' speed and acceleration limits, {limit}"
+        )
+    } else if least_ms > u64::from(max) {
+        format!("the move is to last at least {least_ms} ms, {limit}")
+    } else {
+        // Rounded down to hundredths, so that the largest shown still fits.
+        let most = (f64::from(max) / shortest_ms as f64 * 100.0).floor() / 100.0;
+        format!(
+            "--slower {} makes the move last {} ms, {limit}: it takes {shortest_ms} ms at the \
+             actuators' limits, so --slower can be 1 to {} for this move",
+            number(slower),
+            number((shortest_ms as f64 * slower).ceil()),
+            number(most)
+        )
+    }
 }
 
 /// The wire targets of every node in `plan`: the one place targets become positions.
@@ -256,9 +291,13 @@ async fn sync<T: Transport>(
 ) -> Result<(u64, Instant), MoveError> {
     let shortest = shortest_common_duration(session, plan);
     let slower = if options.slower.is_finite() { options.slower.max(1.0) } else { 1.0 };
-    let duration =
-        ((shortest as f64 * slower).ceil() as u64).max(options.min_duration.as_millis() as u64);
-    let duration_ms = u16::try_from(duration).map_err(|_| MoveError::TooLong(duration))?;
+    let least = u64::try_from(options.min_duration.as_millis()).unwrap_or(u64::MAX);
+    let wanted = (shortest as f64 * slower).ceil().max(least as f64);
+    if wanted > f64::from(Sync::MAX_DURATION_MS) {
+        return Err(MoveError::TooLong { shortest_ms: shortest, slower, least_ms: least });
+    }
+    let duration_ms = wanted as u16;
+    let duration = u64::from(duration_ms);
     let nodes = node_targets(plan);
     let link = session.link();
     let sync = Sync { duration_ms };
@@ -384,4 +423,30 @@ fn progress_of<T: Transport>(
         };
     }
     Progress { nodes: nodes.into_values().collect(), elapsed, duration }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_move_too_long_for_a_sync_says_how_slow_it_can_be() {
+        let message = too_long(4642, 1000.0, 0);
+        assert!(message.starts_with("--slower 1000 makes the move last 4642000 ms"), "{message}");
+        assert!(message.ends_with("--slower can be 1 to 14.11 for this move"), "{message}");
+        // The largest factor shown fits, for any shortest duration.
+        for shortest in [1, 3, 7, 4641, 4642, 30_000, 65_535] {
+            let message = too_long(shortest, MAX_SLOWER, 0);
+            let most: f64 =
+                message.rsplit("1 to ").next().unwrap().split(' ').next().unwrap().parse().unwrap();
+            assert!(
+                (shortest as f64 * most).ceil() <= f64::from(Sync::MAX_DURATION_MS),
+                "{message}"
+            );
+        }
+        assert!(
+            too_long(70_000, 1.0, 0).contains("at the actuators' speed and acceleration limits")
+        );
+        assert!(too_long(10, 1.0, 70_000).contains("at least 70000 ms"));
+    }
 }

@@ -232,7 +232,7 @@ pub enum SessionError {
         quiet: Duration,
     },
     /// Homing did not finish in time.
-    #[error("homing did not finish within {} s: {}", .timeout.as_secs(), .nodes.join(", "))]
+    #[error("homing did not finish within {} s: {}", .timeout.as_secs(), crate::messages::list(.nodes))]
     Homing {
         /// How long the host waited.
         timeout: Duration,

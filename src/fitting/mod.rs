@@ -70,7 +70,7 @@ impl Fit {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FitError {
     /// The profiles cannot give set-points (see [`Profiles::validate`]).
-    #[error("{}", .0.join("; "))]
+    #[error("{}", crate::messages::separated(.0, "; "))]
     Invalid(Vec<String>),
     /// A ring has no actuators.
     #[error("ring {0} has no actuators")]

@@ -14,6 +14,7 @@ use form_description::FormDescription;
 use serde::Serialize;
 
 use super::ring_girth;
+use crate::messages;
 
 /// The default tolerance between a ring's reached girth and the mannequin's, mm: well
 /// inside the 9 mm ISO 20685-1 allows between a scan-derived large girth and a tape measure,
@@ -63,33 +64,33 @@ impl ShapeOutcome {
         if self.reached(ring) {
             "ok".into()
         } else {
-            format!("not reached by {:.0} mm", ring.error_mm().abs())
+            format!("not reached by {} mm", whole_mm(ring.error_mm().abs()))
         }
     }
 
     /// One line for a form that did not take the shape (`None` when every ring is within
-    /// tolerance): `waist not reached by 70 mm (625 wanted, 695 reached), ...`.
+    /// tolerance), the rings furthest off first: `waist not reached by 70 mm (625 mm wanted,
+    /// 695 reached), hip ... and 3 more`.
     pub fn summary(&self) -> Option<String> {
-        let missed: Vec<String> = self
-            .missed()
-            .map(|r| {
-                format!(
-                    "{} {} ({:.0} mm wanted, {:.0} reached)",
-                    r.ring,
-                    self.status(r),
-                    r.target_mm,
-                    r.reached_mm
-                )
-            })
-            .collect();
+        let mut missed: Vec<&RingOutcome> = self.missed().collect();
+        missed.sort_by(|a, b| b.error_mm().abs().total_cmp(&a.error_mm().abs()));
         (!missed.is_empty()).then(|| {
+            let missed = missed.iter().map(|r| {
+                let (target, reached) = (whole_mm(r.target_mm), whole_mm(r.reached_mm));
+                format!("{} {} ({target} mm wanted, {reached} reached)", r.ring, self.status(r))
+            });
             format!(
                 "the form could not take the shape (tolerance {} mm): {}",
-                self.tolerance_mm,
-                missed.join(", ")
+                messages::number(self.tolerance_mm),
+                messages::list(missed)
             )
         })
     }
+}
+
+/// A girth in whole millimetres, as messages show it (short whatever its size).
+fn whole_mm(mm: f64) -> messages::Number {
+    messages::number(mm.round())
 }
 
 /// Compares the girth of every ring of `form` named in `targets` (ring → the mannequin's
@@ -130,5 +131,17 @@ mod tests {
         assert!(summary.contains("waist not reached by 70 mm"), "{summary}");
         let near: BTreeMap<String, f64> = [("waist".to_string(), smallest + 4.9)].into();
         assert_eq!(compare(&form, &retracted, &near, 5.0).summary(), None);
+    }
+
+    #[test]
+    fn a_long_summary_ends_after_a_ring_with_how_many_more() {
+        let form = form_description::reference();
+        let huge: BTreeMap<String, f64> =
+            form.rings.iter().map(|r| (r.name.clone(), 1e308)).collect();
+        let summary = compare(&form, &BTreeMap::new(), &huge, 5.0).summary().unwrap();
+        assert!(summary.chars().count() <= messages::MAX_LINE, "{summary}");
+        assert!(summary.contains("not reached by 1e308 mm (1e308 mm wanted, "), "{summary}");
+        let shown = summary.matches(" wanted, ").count();
+        assert!(summary.ends_with(&format!(" and {} more", form.rings.len() - shown)), "{summary}");
     }
 }

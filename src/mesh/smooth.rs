@@ -10,6 +10,12 @@ use glam::DVec3;
 /// come within about 2 mm of the truth instead of 6-10 mm above it.
 pub const DEFAULT_PASSES: usize = 8;
 
+/// The most passes a command takes: on the demo's scan (149,241 vertices, 1 mm noise) 100
+/// passes keep the girths within 0.5 mm of the default's, 300 move the chest by 3 mm and
+/// 1000 by 12 mm (the body itself is smoothed away), each pass taking about 27 ms; far more
+/// only makes a command run for hours.
+pub const MAX_PASSES: usize = 100;
+
 /// Step toward the neighbours' mean.
 const LAMBDA: f64 = 0.5;
 /// Step back (negative): passes frequencies below about 0.1 of the sampling rate.

@@ -160,8 +160,8 @@ pub enum FrameError {
     },
     /// `--units` makes the body a height no standing person has.
     #[error(
-        "with --units {units} the body is {height_mm:.0} mm tall, and a standing person is \
-         500-2500 mm; {hint}"
+        "with --units {units} the body is {} mm tall, and a standing person is 500-2500 mm; \
+         {hint}", crate::messages::number(height_mm.round())
     )]
     ImplausibleUnits {
         /// The unit given.

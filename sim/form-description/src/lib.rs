@@ -66,16 +66,21 @@
 //! match its centre and an anchor used twice or on a leg ring. Ids may use letters, digits,
 //! `-`, `_` and `.`; `node<N>` is reserved for node names in fault specs.
 //!
+//! Problems show the numbers a file gives short ([`number`]: `1e308`, not 309 digits), so the
+//! reason always fits on its line.
+//!
 //! A node reports one set of capabilities (the weakest of its actuators), and its actuators'
 //! speed and acceleration limits default to them, so give all actuators of a node the same
 //! limits (the reference form does).
 
 mod description;
 mod file;
+mod number;
 mod validate;
 
 pub use description::{
     ActuatorSpec, Anchor, BodyPart, FormDescription, FormSpec, NodeSpec, RingSpec,
 };
 pub use file::{FormError, REFERENCE_TOML, reference};
+pub use number::{Number, number};
 pub use validate::Problem;

@@ -7,6 +7,7 @@ use firmware_protocol::actuator::MAX_ACTUATORS;
 use firmware_protocol::{HUNDREDTHS_PER_MM, NodeId, Position, TENTHS_PER_MM_S2};
 
 use super::description::{ActuatorSpec, BodyPart, FormDescription, FormSpec, RingSpec};
+use super::number::number;
 
 /// Smallest stroke, mm: one step of the wire's positions (0.01 mm).
 const MIN_STROKE_MM: f64 = 1.0 / HUNDREDTHS_PER_MM;
@@ -196,7 +197,11 @@ impl fmt::Display for Problem {
                 write!(f, "node {node}: channel {channel} is used by both `{first}` and `{second}`")
             }
             Self::Value { actuator, field, value, expected } => {
-                write!(f, "actuator `{actuator}`: `{field}` = {value} must be {expected}")
+                write!(
+                    f,
+                    "actuator `{actuator}`: `{field}` = {} must be {expected}",
+                    number(*value)
+                )
             }
             Self::UnknownMirror { actuator, mirror } => {
                 write!(f, "actuator `{actuator}`: `mirror` \"{mirror}\" is not an actuator id")
@@ -263,7 +268,7 @@ impl FormSpec {
             }
             if !(ring.height_mm.is_finite() && ring.height_mm > 0.0) {
                 let problem =
-                    format!("= {} must be a height above the floor (> 0)", ring.height_mm);
+                    format!("= {} must be a height above the floor (> 0)", number(ring.height_mm));
                 problems.push(Problem::RingValue {
                     ring: name.clone(),
                     field: "height_mm",
@@ -271,7 +276,7 @@ impl FormSpec {
                 });
             }
             if !ring.center_mm.iter().all(|c| c.is_finite()) {
-                let problem = format!("= {:?} must be finite", ring.center_mm);
+                let problem = format!("= {} must be finite", point(ring.center_mm));
                 problems.push(Problem::RingValue {
                     ring: name.clone(),
                     field: "center_mm",
@@ -330,8 +335,9 @@ impl FormSpec {
             || !close(mirror.height_mm, ring.height_mm)
         {
             return Some(format!(
-                "its mirror `{}` must be at the same height with centre {expected:?}",
-                mirror.name
+                "its mirror `{}` must be at the same height with centre {}",
+                mirror.name,
+                point(expected)
             ));
         }
         None
@@ -486,8 +492,10 @@ impl FormSpec {
         let turn = (b.angle_deg - mirrored).rem_euclid(360.0);
         if turn.min(360.0 - turn) > MIRROR_TOLERANCE {
             return Some(format!(
-                "angles {}° and {}° are not mirrored (expected {mirrored}°)",
-                a.angle_deg, b.angle_deg
+                "angles {}° and {}° are not mirrored (expected {}°)",
+                number(a.angle_deg),
+                number(b.angle_deg),
+                number(mirrored)
             ));
         }
         let fields = [
@@ -500,7 +508,7 @@ impl FormSpec {
         fields
             .iter()
             .find(|(_, x, y)| !close(*x, *y))
-            .map(|(field, x, y)| format!("`{field}` differs ({x} and {y})"))
+            .map(|(field, x, y)| format!("`{field}` differs ({} and {})", number(*x), number(*y)))
     }
 }
 
@@ -515,11 +523,19 @@ fn part_problem(ring: &RingSpec) -> Option<String> {
     };
     (!fits && x.is_finite()).then(|| match ring.part {
         BodyPart::Torso => format!(
-            "the ring is off the body axis (x = {x} mm): a leg ring says \
-             `part = \"left-leg\"` (x > 0) or `\"right-leg\"` (x < 0)"
+            "the ring is off the body axis (x = {} mm): a leg ring says \
+             `part = \"left-leg\"` (x > 0) or `\"right-leg\"` (x < 0)",
+            number(x)
         ),
-        leg => format!("\"{}\" needs its centre on that side (x = {x} mm)", leg.name()),
+        leg => {
+            format!("\"{}\" needs its centre on that side (x = {} mm)", leg.name(), number(x))
+        }
     })
+}
+
+/// A ring centre as problems show it: `[x, y]`, each number short.
+fn point([x, y]: [f64; 2]) -> String {
+    format!("[{}, {}]", number(x), number(y))
 }
 
 fn close(a: f64, b: f64) -> bool {

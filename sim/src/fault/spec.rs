@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use super::{ActuatorFaultAt, FaultSpec, NodeFault, NodeFaultAt, Window};
 use crate::node::ActuatorFault;
-use form_description::FormDescription;
+use form_description::{FormDescription, number};
 
 /// A fault spec item that could not be understood, or names what the form lacks.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -121,7 +121,7 @@ fn window(text: &str) -> Result<Window, String> {
 }
 
 fn duration(text: &str) -> Result<Duration, String> {
-    let (number, ns_per_unit) = if let Some(n) = text.strip_suffix("us") {
+    let (amount, ns_per_unit) = if let Some(n) = text.strip_suffix("us") {
         (n, 1e3)
     } else if let Some(n) = text.strip_suffix("ms") {
         (n, 1e6)
@@ -131,12 +131,16 @@ fn duration(text: &str) -> Result<Duration, String> {
         return Err(format!("`{text}` needs a unit: us, ms or s"));
     };
     // Rounded to the nanosecond, so that `1.5s` and `1500ms` are the same duration.
-    let ns = number.parse::<f64>().map(|n| (n * ns_per_unit).round());
+    let ns = amount.parse::<f64>().map(|n| (n * ns_per_unit).round());
     match ns {
-        Ok(ns) if (0.0..1e18).contains(&ns) => Ok(Duration::from_nanos(ns as u64)),
-        _ => Err(format!("`{text}` is not a duration")),
+        Ok(ns) if (0.0..LONGEST_S * 1e9).contains(&ns) => Ok(Duration::from_nanos(ns as u64)),
+        _ => Err(format!("`{text}` is not a duration from 0 to {} s", number(LONGEST_S))),
     }
 }
+
+/// The longest time a spec names, s: about 32 years, beyond any run, and in nanoseconds well
+/// within what a `Duration` built from a `u64` holds.
+const LONGEST_S: f64 = 1e9;
 
 fn probability(text: &str) -> Result<f64, String> {
     text.parse::<f64>()
@@ -284,6 +288,7 @@ mod tests {
             ("flood=3", "expected"),
             ("node3:silent", "@time"),
             ("delay=-1ms", "not a duration"),
+            ("node3:reboot@1e308s", "is not a duration from 0 to 1e9 s"),
         ] {
             let error = spec.parse::<FaultSpec>().unwrap_err();
             assert!(error.to_string().contains(words), "{spec}: {error}");
