@@ -71,10 +71,10 @@ impl<T: Transport> Claim<T> {
         let watch = async {
             loop {
                 if session.wait_until(Instant::now() + HOLD_SLICE, fresh_stop).await? {
-                    return Err(SessionError::StoppedSinceStart(names(
+                    return Err(SessionError::StoppedSinceStart(names(&newly_stopped(
                         session,
-                        &newly_stopped(session, stopped_at_start),
-                    )));
+                        stopped_at_start,
+                    ))));
                 }
             }
         };
@@ -114,7 +114,7 @@ impl<T: Transport> Claim<T> {
                 if !newly_stopped(&session, &stopped_at_start).is_empty() =>
             {
                 let late = newly_stopped(&session, &stopped_at_start);
-                return Err(SessionError::StoppedSinceStart(names(&session, &late)).into());
+                return Err(SessionError::StoppedSinceStart(names(&late)).into());
             }
             result => result?,
         };
@@ -180,7 +180,7 @@ fn newly_stopped<T: Transport>(
     estopped(session).difference(stopped_at_start).copied().collect()
 }
 
-/// The nodes' names for a message.
-fn names<T: Transport>(session: &Session<T>, nodes: &[NodeId]) -> Vec<String> {
-    nodes.iter().map(|&n| session.node_name(n).to_string()).collect()
+/// The nodes' addresses for a message (eight names would not fit its line).
+fn names(nodes: &[NodeId]) -> Vec<u8> {
+    nodes.iter().map(|n| n.get()).collect()
 }

@@ -248,10 +248,10 @@ pub enum SessionError {
     /// A FaultReset did not clear a node's faults (their cause remains).
     #[error("faults not cleared (their cause remains):\n  {}", .0.join("\n  "))]
     NotCleared(Vec<String>),
-    /// An e-stop latched on these nodes after the command claimed the form (see
+    /// An e-stop latched on these nodes (addresses) after the command claimed the form (see
     /// [`super::claim`]): the command ends without clearing it.
-    #[error("stopped by an e-stop latched on {} after this command started (it is not cleared: check the form, then `dressform reset`)", .0.join(", "))]
-    StoppedSinceStart(Vec<String>),
+    #[error("stopped by an e-stop latched on node(s) {} after this command started (not cleared: check the form, then `dressform reset`)", crate::messages::list(.0))]
+    StoppedSinceStart(Vec<u8>),
     /// The link was e-stopped (another terminal, a signal): the session sent nothing more.
     #[error("stopped by {0}: emergency stop sent to every node")]
     Stopped(StopCause),
