@@ -11,7 +11,7 @@ use dressform::controller::motion::MAX_SLOWER;
 use dressform::controller::simulated::SimConfig;
 use dressform::controller::{
     Claim, DEFAULT_TOLERANCE_MM, DriveError, DriveOptions, DriveReport, LinkSpec, MoveError,
-    Progress, SessionError, Transport, plan,
+    Progress, SessionError, plan,
 };
 use dressform::fitting::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
 use dressform::messages;
@@ -168,13 +168,7 @@ pub fn execute<R: Send + 'static>(
     let result = runtime.block_on(async {
         let config = SimConfig { faults, log: sim.log.clone(), ..SimConfig::default() };
         let owned = link::own(link, form, &config)?;
-        let device = owned.connection.device();
         let mut claim = Claim::take(owned.connection, form).await.map_err(DriveError::from)?;
-        errln!(
-            "{device}: form \"{}\" claimed ({} nodes answer); an e-stop from now on ends this command",
-            form.name,
-            form.nodes.len()
-        );
         let (computed, result) = tokio::sync::oneshot::channel();
         std::thread::Builder::new()
             .name("dressform compute".into())

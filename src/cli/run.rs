@@ -124,7 +124,20 @@ pub fn shape_form<X: Send + 'static>(
     prepare: impl FnOnce() -> Result<Prepared<X>, Failure> + Send + 'static,
 ) -> Result<(Reshaped, ShapeOutcome, X), Failure> {
     let (shape_of, out_dir) = (form.clone(), out.to_path_buf());
+    let device = match drive.link {
+        LinkSpec::Sim => "simulated bus".to_string(),
+        LinkSpec::Serial(path) | LinkSpec::Slcan(path) => path.display().to_string(),
+        LinkSpec::Can(interface) => interface.clone(),
+    };
+    // Said once the form is claimed, as the computation starts: from here on an e-stop ends
+    // the command.
+    let claimed = format!(
+        "{device}: form \"{}\" claimed ({} nodes answer); an e-stop from now on ends this command",
+        form.name,
+        form.nodes.len()
+    );
     let compute = move || {
+        errln!("{claimed}");
         let Prepared { scan, reconstruct, outputs, extra } = prepare()?;
         let done = reconstruct_and_write(&scan, &reconstruct, &shape_of, &out_dir, outputs)?;
         let setpoints = done.shaped.setpoints.clone();
