@@ -35,7 +35,7 @@ use std::os::fd::AsRawFd;
 use std::os::linux::net::SocketAddrExt;
 use std::os::unix::net::{SocketAddr, UnixListener, UnixStream};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::time::Duration;
 
 use super::transport::LinkSpec;
@@ -186,12 +186,42 @@ enum Slot {
     Open(Gate),
 }
 
+/// How many clients are being answered a stop: from the moment a client's request is read
+/// to the moment its answer is written. The stop itself ends the owner's command at once, so
+/// the owner waits for these answers before it closes the endpoint; a client that gets none
+/// would send the stop again on the link, beside its owner.
+#[derive(Debug, Default)]
+struct Answering {
+    count: Mutex<usize>,
+    done: Condvar,
+}
+
+impl Answering {
+    fn start(&self) {
+        *self.count.lock().unwrap_or_else(PoisonError::into_inner) += 1;
+    }
+
+    fn end(&self) {
+        let mut count = self.count.lock().unwrap_or_else(PoisonError::into_inner);
+        *count = count.saturating_sub(1);
+        self.done.notify_all();
+    }
+
+    /// Waits until no answer is pending, at most `timeout`.
+    fn wait(&self, timeout: Duration) {
+        let count = self.count.lock().unwrap_or_else(PoisonError::into_inner);
+        let _ = self.done.wait_timeout_while(count, timeout, |c| *c > 0);
+    }
+}
+
 /// The endpoint of the process that owns a link, answering e-stops on threads of its own.
-/// Dropping it closes the socket.
+/// Dropping it waits for the answers being written (at most [`REPLY_TIMEOUT`]), then closes
+/// the socket.
 #[derive(Debug)]
 pub struct Endpoint {
     name: String,
     gate: Arc<Mutex<Slot>>,
+    answering: Arc<Answering>,
     closing: Arc<AtomicBool>,
     thread: Option<std::thread::JoinHandle<()>>,
 }
@@ -214,15 +244,17 @@ impl Endpoint {
             Err(e) => return Err(io(e)),
         };
         let gate: Arc<Mutex<Slot>> = Arc::default();
+        let answering: Arc<Answering> = Arc::default();
         let closing = Arc::new(AtomicBool::new(false));
         let thread = {
-            let (gate, closing) = (Arc::clone(&gate), Arc::clone(&closing));
+            let (gate, answering, closing) =
+                (Arc::clone(&gate), Arc::clone(&answering), Arc::clone(&closing));
             std::thread::Builder::new()
                 .name("dressform control endpoint".into())
-                .spawn(move || listen(&listener, &gate, &closing))
+                .spawn(move || listen(&listener, &gate, &answering, &closing))
                 .map_err(io)?
         };
-        Ok(Some(Self { name, gate, closing, thread: Some(thread) }))
+        Ok(Some(Self { name, gate, answering, closing, thread: Some(thread) }))
     }
 
     /// From now on, e-stops go to `gate`; one that came while the link was opening is sent
@@ -242,6 +274,7 @@ impl Endpoint {
 
 impl Drop for Endpoint {
     fn drop(&mut self) {
+        self.answering.wait(REPLY_TIMEOUT);
         self.closing.store(true, Ordering::SeqCst);
         // Wake the accepting thread so it sees `closing`.
         if let Ok(address) = address(&self.name) {
@@ -254,31 +287,45 @@ impl Drop for Endpoint {
 }
 
 /// Accepts clients until `closing`, each answered on a thread of its own.
-fn listen(listener: &UnixListener, gate: &Arc<Mutex<Slot>>, closing: &AtomicBool) {
+fn listen(
+    listener: &UnixListener,
+    gate: &Arc<Mutex<Slot>>,
+    answering: &Arc<Answering>,
+    closing: &AtomicBool,
+) {
     for stream in listener.incoming() {
         if closing.load(Ordering::SeqCst) {
             return;
         }
         // A client that fails mid-request loses its answer; the endpoint goes on.
         let Ok(stream) = stream else { continue };
-        let gate = Arc::clone(gate);
-        let answering = std::thread::Builder::new()
+        let (gate, answering) = (Arc::clone(gate), Arc::clone(answering));
+        let spawned = std::thread::Builder::new()
             .name("dressform control client".into())
             .stack_size(ANSWER_STACK_BYTES)
             .spawn(move || {
-                let _ = answer(stream, &gate);
+                let _ = answer(stream, &gate, &answering);
             });
         // Out of threads: that client gets no answer (it then sends the stop on the link).
-        drop(answering);
+        drop(spawned);
     }
 }
 
-/// Reads one request and answers it.
-fn answer(stream: UnixStream, gate: &Mutex<Slot>) -> io::Result<()> {
+/// Reads one request and answers it (counted in `answering` from the request's reading to
+/// the answer's writing).
+fn answer(stream: UnixStream, gate: &Mutex<Slot>, answering: &Answering) -> io::Result<()> {
     stream.set_read_timeout(Some(REPLY_TIMEOUT))?;
     stream.set_write_timeout(Some(REPLY_TIMEOUT))?;
     let mut line = String::new();
     BufReader::new((&stream).take(MAX_LINE)).read_line(&mut line)?;
+    answering.start();
+    let written = reply(&stream, &line, gate);
+    answering.end();
+    written
+}
+
+/// Carries out one request line and writes the answer.
+fn reply(stream: &UnixStream, line: &str, gate: &Mutex<Slot>) -> io::Result<()> {
     let reply = if line.trim() != ESTOP {
         format!("failed to understand the request {:?}", line.trim())
     } else {
@@ -296,7 +343,7 @@ fn answer(stream: UnixStream, gate: &Mutex<Slot>) -> io::Result<()> {
             Err(e) => format!("failed to send the emergency stop: {e}"),
         }
     };
-    (&stream).write_all(format!("{reply}\n").as_bytes())
+    (&*stream).write_all(format!("{reply}\n").as_bytes())
 }
 
 fn device_name(spec: &LinkSpec) -> String {
