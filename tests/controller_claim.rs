@@ -8,22 +8,21 @@
 
 use std::os::linux::net::SocketAddrExt;
 use std::os::unix::net::{SocketAddr, UnixStream};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use dressform::controller::control::{self, REPLY_TIMEOUT};
 use dressform::controller::transport::shared_stop_gate;
 use dressform::controller::{LinkSpec, StopCause};
-use dressform::mesh::Mesh;
-use dressform::scan::format::Format;
 use embedded_can::{Frame as _, StandardId};
 use firmware_protocol::drive::{DriveCommand, Faults};
 use firmware_protocol::{Message, Packet, can};
 use form_description::reference;
-use glam::DVec3;
-use sim::capture::{Artifacts, BodyParams, capture, generate};
 use sim::serve::{ServeConfig, Server, Transport, serve};
+
+use crate::controller_estop::flag;
+use crate::run_end_to_end::scan_file;
 
 /// Tries per link (the acceptance: 10).
 const TRIES: usize = 10;
@@ -32,13 +31,6 @@ const TRIES: usize = 10;
 const CLAIM_TIMEOUT: Duration = Duration::from_secs(30);
 /// How long the nodes may take to latch an e-stop on a loaded machine (~10 ms quiet).
 const LATCH_TIMEOUT: Duration = Duration::from_secs(5);
-
-fn flag(transport: Transport) -> &'static str {
-    match transport {
-        Transport::SerialPty => "--serial",
-        Transport::SlcanPty => "--slcan",
-    }
-}
 
 fn spec(server: &Server, transport: Transport) -> LinkSpec {
     let path = server.device_path().to_path_buf();
@@ -55,17 +47,6 @@ fn text(output: &Output) -> String {
         String::from_utf8_lossy(&output.stdout),
         String::from_utf8_lossy(&output.stderr)
     )
-}
-
-/// The default synthetic customer's scan, as a scanner writes it.
-fn scan_file(dir: &Path) -> PathBuf {
-    let body = generate(&BodyParams::default()).unwrap();
-    let raw = capture(&body, &Artifacts::typical_scanner(2));
-    let mesh =
-        Mesh::new(raw.positions.iter().map(|&p| DVec3::from_array(p)).collect(), raw.triangles);
-    let path = dir.join("scan.ply");
-    std::fs::write(&path, Format::Ply.encode(&mesh)).unwrap();
-    path
 }
 
 /// What `run` and `drive` say once the form is claimed.
@@ -156,6 +137,16 @@ fn nothing_moves_after_the_stop(log: &Path) {
     assert!(after.is_empty(), "motion after the e-stop: {after:?}");
 }
 
+/// `dressform estop` on the served form, from another process with `env` set.
+fn estop(server: &Server, transport: Transport, env: &[(&str, &Path)]) -> Output {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_dressform"));
+    command.args(["estop", flag(transport)]).arg(server.device_path());
+    for (key, value) in env {
+        command.env(key, value);
+    }
+    command.output().unwrap()
+}
+
 /// `dressform run` of `scan` over the served form, as a child process.
 fn spawn_run(server: &Server, transport: Transport, scan: &Path, out: &Path) -> Child {
     Command::new(env!("CARGO_BIN_EXE_dressform"))
@@ -197,13 +188,7 @@ fn stopped_while_computing(transport: Transport, press: Press) {
         // Spread the press over the computation (seconds long).
         std::thread::sleep(Duration::from_millis(100 * attempt as u64));
         let pressed = match press {
-            Press::Estop => Some(
-                Command::new(env!("CARGO_BIN_EXE_dressform"))
-                    .args(["estop", flag(transport)])
-                    .arg(server.device_path())
-                    .output()
-                    .unwrap(),
-            ),
+            Press::Estop => Some(estop(&server, transport, &[])),
             Press::OnTheNodes => {
                 shared_stop_gate(&spec).unwrap().emergency_stop(StopCause::Requested).unwrap();
                 None
@@ -302,11 +287,7 @@ fn silent_clients_do_not_delay_the_stop() {
         let silent: Vec<UnixStream> =
             (0..5).map(|_| UnixStream::connect_addr(&address).unwrap()).collect();
         let start = Instant::now();
-        let estop = Command::new(env!("CARGO_BIN_EXE_dressform"))
-            .args(["estop", flag(transport)])
-            .arg(server.device_path())
-            .output()
-            .unwrap();
+        let estop = estop(&server, transport, &[]);
         wait_latched(&server);
         // The latency itself is `cargo bench --bench estop`'s (the README's table); here, far
         // below one silent client's read timeout.
@@ -336,13 +317,7 @@ fn estop_needs_no_shared_runtime_folder() {
             // Root can give it to another user (nobody), as on a shared studio PC.
             std::os::unix::fs::chown(&squatted, Some(65534), Some(65534)).unwrap();
         }
-        let estop = Command::new(env!("CARGO_BIN_EXE_dressform"))
-            .args(["estop", flag(transport)])
-            .arg(server.device_path())
-            .env("XDG_RUNTIME_DIR", &runtime)
-            .env("TMPDIR", &tmp)
-            .output()
-            .unwrap();
+        let estop = estop(&server, transport, &[("XDG_RUNTIME_DIR", &runtime), ("TMPDIR", &tmp)]);
         assert_eq!(estop.status.code(), Some(0), "{}", text(&estop));
         wait_latched(&server);
         let out = drive.wait_with_output().unwrap();
@@ -387,11 +362,7 @@ fn a_hung_owner_does_not_keep_the_stop_from_the_form() {
         let pid = libc::pid_t::try_from(drive.id()).unwrap();
         // SAFETY: kill has no memory effects; `pid` is our child, not yet reaped.
         assert_eq!(unsafe { libc::kill(pid, libc::SIGSTOP) }, 0);
-        let estop = Command::new(env!("CARGO_BIN_EXE_dressform"))
-            .args(["estop", flag(transport)])
-            .arg(server.device_path())
-            .output()
-            .unwrap();
+        let estop = estop(&server, transport, &[]);
         // The e-stop flag is latched only by an EmergencyStop (a host timeout is another).
         wait_latched(&server);
         // SAFETY: as above.

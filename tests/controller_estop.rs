@@ -21,7 +21,7 @@ const START_TIMEOUT: Duration = Duration::from_secs(30);
 /// gives the measured latency), this much on a loaded one.
 const LATCH_TIMEOUT: Duration = Duration::from_secs(5);
 
-fn flag(transport: Transport) -> &'static str {
+pub(crate) fn flag(transport: Transport) -> &'static str {
     match transport {
         Transport::SerialPty => "--serial",
         Transport::SlcanPty => "--slcan",

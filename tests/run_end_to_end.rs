@@ -11,7 +11,7 @@ use glam::DVec3;
 use sim::capture::{Artifacts, BodyParams, capture, generate};
 use sim::serve::{ServeConfig, Transport, serve};
 
-fn scan_file(dir: &std::path::Path) -> std::path::PathBuf {
+pub(crate) fn scan_file(dir: &std::path::Path) -> std::path::PathBuf {
     scan_of(dir, &BodyParams::default())
 }
 
