@@ -21,7 +21,7 @@ use firmware_protocol::{Message, Packet, can};
 use form_description::reference;
 use sim::serve::{ServeConfig, Server, Transport, serve};
 
-use crate::controller_estop::flag;
+use crate::controller_estop::{flag, text};
 use crate::run_end_to_end::scan_file;
 
 /// Tries per link (the acceptance: 10).
@@ -38,15 +38,6 @@ fn spec(server: &Server, transport: Transport) -> LinkSpec {
         Transport::SerialPty => LinkSpec::Serial(path),
         Transport::SlcanPty => LinkSpec::Slcan(path),
     }
-}
-
-fn text(output: &Output) -> String {
-    format!(
-        "status {:?}\nstdout:\n{}\nstderr:\n{}",
-        output.status.code(),
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    )
 }
 
 /// What `run` and `drive` say once the form is claimed.

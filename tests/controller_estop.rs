@@ -43,7 +43,7 @@ fn dressform(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_dressform")).args(args).output().expect("dressform runs")
 }
 
-fn text(output: &Output) -> String {
+pub(crate) fn text(output: &Output) -> String {
     format!(
         "status {:?}\nstdout:\n{}\nstderr:\n{}",
         output.status.code(),
