@@ -56,11 +56,6 @@ impl<T: Transport> Claim<T> {
         Ok(Self { session, stopped_at_start })
     }
 
-    /// The nodes that held a latched e-stop when the form was claimed.
-    pub fn stopped_at_start(&self) -> &BTreeSet<NodeId> {
-        &self.stopped_at_start
-    }
-
     /// Runs `work` while keeping the link alive (heartbeats, polls, liveness). Ends early with
     /// an error when the link is e-stopped ([`SessionError::Stopped`]), an e-stop latches on a
     /// node that had none at the start ([`SessionError::StoppedSinceStart`]), or the link
