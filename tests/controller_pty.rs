@@ -100,7 +100,17 @@ fn a_host_that_went_away_leaves_no_answers_for_the_next() {
     // 8 Identity (6 bytes) and 8 Capabilities lines, at least `tIIIL` and `\r` each.
     let answers = 16 * 6;
     let deadline = std::time::Instant::now() + Duration::from_secs(10);
-    while gone.bytes_to_read().unwrap() < answers {
+    // All of them left unread: at least `answers` bytes, then no more for `SETTLED` (the
+    // answers still on their way when the host goes are answers in flight, not left over).
+    const SETTLED: Duration = Duration::from_millis(200);
+    let (mut seen, mut since) = (0, std::time::Instant::now());
+    loop {
+        let waiting = gone.bytes_to_read().unwrap();
+        if waiting != seen {
+            (seen, since) = (waiting, std::time::Instant::now());
+        } else if seen >= answers && since.elapsed() >= SETTLED {
+            break;
+        }
         assert!(std::time::Instant::now() < deadline, "the nodes did not answer");
         std::thread::sleep(Duration::from_millis(10));
     }
