@@ -6,8 +6,8 @@
 //! `$DRESSFORM_MAKEHUMAN`) and is skipped with a message without it.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use dressform::body_model::{self, BodyModel, BuildOptions};
-use dressform::makehuman::MakeHuman;
+use dressform::pose::body_model::{self, BodyModel, BuildOptions};
+use dressform::pose::makehuman::MakeHuman;
 use glam::DVec3;
 use std::path::PathBuf;
 use std::time::Duration;

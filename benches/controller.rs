@@ -11,10 +11,10 @@ use std::collections::BTreeMap;
 use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use dressform::controller::motion::node_targets;
-use dressform::controller::transport::sim::SimBus;
-use dressform::controller::{Transport, plan};
-use dressform::setpoints::SetPoints;
+use dressform::form::controller::motion::node_targets;
+use dressform::form::controller::transport::sim::SimBus;
+use dressform::form::controller::{Transport, plan};
+use dressform::form::setpoints::SetPoints;
 use firmware_protocol::Link;
 use firmware_protocol::message::Sync;
 use firmware_protocol::update::packets;

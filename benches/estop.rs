@@ -15,8 +15,8 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, SamplingMode, criterion_group, criterion_main};
-use dressform::controller::LinkSpec;
-use dressform::controller::control::socket_name;
+use dressform::form::controller::LinkSpec;
+use dressform::form::controller::control::socket_name;
 use firmware_protocol::drive::Faults;
 use form_description::reference;
 use sim::serve::{ServeConfig, Server, Transport, serve};

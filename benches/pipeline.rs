@@ -8,13 +8,13 @@
 //! `cargo bench --bench pipeline`; needs `../shared/makehuman` (or `$DRESSFORM_MAKEHUMAN`).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use dressform::mannequin::MannequinOptions;
-use dressform::mesh::Mesh;
-use dressform::pipeline::symmetrize;
-use dressform::preview::{preview_png, sections_svg};
-use dressform::scan::format::Format;
-use dressform::scan::{self, frame::FrameOptions};
-use dressform::slice::sections;
+use dressform::body::mesh::Mesh;
+use dressform::body::scan::format::Format;
+use dressform::body::scan::{self, frame::FrameOptions};
+use dressform::body::slice::sections;
+use dressform::run::pipeline::symmetrize;
+use dressform::run::preview::{preview_png, sections_svg};
+use dressform::shape::mannequin::MannequinOptions;
 use glam::DVec3;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -133,9 +133,9 @@ fn benches(c: &mut Criterion) {
 /// (about 300k triangles), standing with the left arm 15 degrees and the right leg 5 degrees
 /// further out, captured with a typical scanner's noise and holes and written as binary PLY.
 fn reconstruct_benches(c: &mut Criterion) {
-    use dressform::body_model::BodyModel;
-    use dressform::fit::{self, FitOptions, ScanPoints};
-    use dressform::reconstruct::{ReconstructOptions, reconstruct};
+    use dressform::pose::body_model::BodyModel;
+    use dressform::pose::model_fit::{self, FitOptions, ScanPoints};
+    use dressform::run::reconstruct::{ReconstructOptions, reconstruct};
     use sim::capture::{Artifacts, BodyParams, capture, generate};
     let mut params = BodyParams::default();
     params.pose.left_arm.abduction_deg += 15.0;
@@ -152,11 +152,11 @@ fn reconstruct_benches(c: &mut Criterion) {
     let model = BodyModel::builtin();
     let mut group = c.benchmark_group("reconstruct");
     group.sample_size(10);
-    let extended = fit::segment_lengths::extended(&model);
+    let extended = model_fit::segment_lengths::extended(&model);
     group.bench_function(format!("fit alone, {n} triangles"), |b| {
         b.iter(|| {
             let points = ScanPoints::of_mesh(&scan.body);
-            fit::fit(&extended, &points, &FitOptions::default()).expect("fit")
+            model_fit::fit(&extended, &points, &FitOptions::default()).expect("fit")
         })
     });
     group.bench_function(format!("reconstruct (library), {n} triangles"), |b| {

@@ -7,9 +7,9 @@
 //! `cargo bench --bench scan_info`
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use dressform::mesh::Mesh;
-use dressform::report::ScanInfo;
-use dressform::scan::{self, format::Format, frame::FrameOptions};
+use dressform::body::mesh::Mesh;
+use dressform::body::scan::{self, format::Format, frame::FrameOptions};
+use dressform::run::info::ScanInfo;
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
 use std::path::Path;

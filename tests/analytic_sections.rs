@@ -2,8 +2,8 @@
 //! stacks of ellipses and superellipses (cut exactly through their vertex rings as well as
 //! between them), and a non-star-shaped section.
 
-use dressform::mesh::{Mesh, topology};
-use dressform::slice::sections;
+use dressform::body::mesh::{Mesh, topology};
+use dressform::body::slice::sections;
 use glam::{DVec2, DVec3};
 use std::f64::consts::{PI, TAU};
 

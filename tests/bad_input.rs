@@ -117,8 +117,9 @@ fn missing_file_and_unknown_format() {
 #[test]
 fn truncated_binary_stl() {
     let dir = tempfile::tempdir().unwrap();
-    let mesh = dressform::scan::format::Format::Obj.read(octahedron_obj("").as_bytes()).unwrap();
-    let full = dressform::scan::format::Format::Stl.encode(&mesh);
+    let mesh =
+        dressform::body::scan::format::Format::Obj.read(octahedron_obj("").as_bytes()).unwrap();
+    let full = dressform::body::scan::format::Format::Stl.encode(&mesh);
     assert_rejected(&write(dir.path(), "cut.stl", &full[..full.len() - 7]), "truncated");
     assert_rejected(&write(dir.path(), "tiny.stl", &full[..40]), "truncated");
 }
@@ -126,8 +127,9 @@ fn truncated_binary_stl() {
 #[test]
 fn truncated_binary_ply() {
     let dir = tempfile::tempdir().unwrap();
-    let mesh = dressform::scan::format::Format::Obj.read(octahedron_obj("").as_bytes()).unwrap();
-    let full = dressform::scan::format::Format::Ply.encode(&mesh);
+    let mesh =
+        dressform::body::scan::format::Format::Obj.read(octahedron_obj("").as_bytes()).unwrap();
+    let full = dressform::body::scan::format::Format::Ply.encode(&mesh);
     assert_rejected(&write(dir.path(), "cut.ply", &full[..full.len() - 5]), "truncated");
 }
 
@@ -381,7 +383,7 @@ fn huge_fans_and_polygons_are_read_in_linear_time() {
 fn line_endings_and_messages() {
     let dir = tempfile::tempdir().unwrap();
     let lf = octahedron_obj("");
-    let mesh = dressform::scan::format::Format::Obj.read(lf.as_bytes()).unwrap();
+    let mesh = dressform::body::scan::format::Format::Obj.read(lf.as_bytes()).unwrap();
     let mut ply = format!(
         "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
          property double z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
@@ -645,7 +647,7 @@ fn betas_beyond_five_sigma_are_refused() {
 /// NaN or infinite coordinates.
 #[test]
 fn a_body_model_with_non_finite_vertices_is_refused() {
-    use dressform::body_model::{BodyModel, file};
+    use dressform::pose::body_model::{BodyModel, file};
     let dir = tempfile::tempdir().unwrap();
     let mut model = BodyModel::builtin();
     model.mean[7].z = f64::NAN;

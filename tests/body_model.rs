@@ -1,10 +1,10 @@
-//! The statistical body model (`dressform::body_model`, paper 3.1.1): mean value coordinates,
+//! The statistical body model (`dressform::pose::body_model`, paper 3.1.1): mean value coordinates,
 //! skinning, the PCA space, symmetry, the glTF file, the built-in model and the CLI.
 
 use crate::common;
-use dressform::body_model::{self, BodyModel, BuildOptions, file, mvc, population, template};
-use dressform::makehuman::MakeHuman;
-use dressform::mesh::{Mesh, topology};
+use dressform::body::mesh::{Mesh, topology};
+use dressform::pose::body_model::{self, BodyModel, BuildOptions, file, mvc, population, template};
+use dressform::pose::makehuman::MakeHuman;
 use glam::DVec3;
 use std::sync::OnceLock;
 
@@ -340,7 +340,7 @@ fn the_cli_builds_describes_and_samples_models() {
         body.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
-    let (mesh, _) = dressform::scan::read_mesh(&body).unwrap();
+    let (mesh, _) = dressform::body::scan::read_mesh(&body).unwrap();
     let expected = builtin().shape(&[2.0, -1.5, 0.5]);
     assert!(mesh.positions.iter().zip(&expected).all(|(a, b)| a.distance(*b) < 1e-9));
     let (code, _, err) =
@@ -355,7 +355,7 @@ fn the_cli_builds_describes_and_samples_models() {
         (0..8).map(|i| (0..6).map(|k| ((i * 7 + k * 3) % 5) as f64 - 2.0).collect()).collect();
     for (i, beta) in betas.iter().enumerate() {
         let mesh = builtin().mesh(builtin().shape(beta));
-        let bytes = dressform::scan::format::Format::Ply.encode(&mesh);
+        let bytes = dressform::body::scan::format::Format::Ply.encode(&mesh);
         std::fs::write(meshes.join(format!("body{i}.ply")), bytes).unwrap();
     }
     let out_model = dir.path().join("db.glb");

@@ -4,10 +4,10 @@
 use crate::common;
 
 use common::{dressform, makehuman};
-use dressform::mesh::Mesh;
-use dressform::output::write_atomically;
-use dressform::scan::format::Format;
-use dressform::scan::{self, frame::FrameOptions};
+use dressform::atomic_output::write_atomically;
+use dressform::body::mesh::Mesh;
+use dressform::body::scan::format::Format;
+use dressform::body::scan::{self, frame::FrameOptions};
 use glam::{DMat3, DVec3};
 use std::path::Path;
 

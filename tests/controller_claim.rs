@@ -12,9 +12,9 @@ use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use dressform::controller::control::{self, REPLY_TIMEOUT};
-use dressform::controller::transport::shared_stop_gate;
-use dressform::controller::{LinkSpec, StopCause};
+use dressform::form::controller::control::{self, REPLY_TIMEOUT};
+use dressform::form::controller::transport::shared_stop_gate;
+use dressform::form::controller::{LinkSpec, StopCause};
 use embedded_can::{Frame as _, StandardId};
 use firmware_protocol::drive::{DriveCommand, Faults};
 use firmware_protocol::{Message, Packet, can};

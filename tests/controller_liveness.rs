@@ -19,10 +19,12 @@ use std::process::{Child, ChildStdout, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
-use dressform::controller::session::{LINK_STALL_LIMIT, NODE_LOST_AFTER, Session, SessionError};
-use dressform::controller::transport::sim::SimBus;
-use dressform::controller::{Connection, DriveError, DriveOptions, LinkSpec, drive, status};
-use dressform::setpoints::SetPoints;
+use dressform::form::controller::session::{
+    LINK_STALL_LIMIT, NODE_LOST_AFTER, Session, SessionError,
+};
+use dressform::form::controller::transport::sim::SimBus;
+use dressform::form::controller::{Connection, DriveError, DriveOptions, LinkSpec, drive, status};
+use dressform::form::setpoints::SetPoints;
 use firmware_protocol::drive::{DriveState, Faults};
 use form_description::reference;
 use sim::bus::can::{CanBus, CanKind};
@@ -288,7 +290,7 @@ fn drive_through_a_stop(
         let connection = Connection::open(&spec).map_err(|e| e.to_string())?;
         let options = DriveOptions { min_duration: MOVE, ..Default::default() };
         let mut told = false;
-        let progress = |p: &dressform::controller::Progress| {
+        let progress = |p: &dressform::form::controller::Progress| {
             if !told && p.elapsed >= STOP_AT {
                 told = true;
                 let _ = moving.send(());

@@ -5,11 +5,11 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use dressform::controller::session::{LINK_STALL_LIMIT, Session, SessionError};
-use dressform::controller::transport::serial::SerialLine;
-use dressform::controller::transport::slcan::Slcan;
-use dressform::controller::{Connection, DriveOptions, LinkSpec, Transport, drive, status};
-use dressform::setpoints::SetPoints;
+use dressform::form::controller::session::{LINK_STALL_LIMIT, Session, SessionError};
+use dressform::form::controller::transport::serial::SerialLine;
+use dressform::form::controller::transport::slcan::Slcan;
+use dressform::form::controller::{Connection, DriveOptions, LinkSpec, Transport, drive, status};
+use dressform::form::setpoints::SetPoints;
 use firmware_protocol::NodeId;
 use firmware_protocol::drive::{DriveCommand, Faults};
 use form_description::reference;
@@ -146,7 +146,7 @@ fn a_slow_serial_adapter_does_not_make_answering_nodes_lost() {
 fn an_emergency_stop_over_the_serial_pty_reaches_every_node() {
     let (_runtime, server) = start(Served::SerialPty);
     let connection = Connection::open(&LinkSpec::Serial(server.device_path().into())).unwrap();
-    dressform::controller::emergency_stop(&connection).unwrap();
+    dressform::form::controller::emergency_stop(&connection).unwrap();
     std::thread::sleep(Duration::from_millis(100));
     for node in server.form().state().nodes {
         assert!(node.faults.contains(Faults::EMERGENCY_STOP), "node {}", node.node.get());

@@ -7,9 +7,9 @@
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
-use dressform::controller::transport::sim::SimBus;
-use dressform::controller::{DriveOptions, Gate, Transport, TransportError, drive};
-use dressform::setpoints::SetPoints;
+use dressform::form::controller::transport::sim::SimBus;
+use dressform::form::controller::{DriveOptions, Gate, Transport, TransportError, drive};
+use dressform::form::setpoints::SetPoints;
 use firmware_protocol::{Address, Link, Message, Packet};
 use form_description::{FormDescription, reference};
 use proptest::prelude::*;

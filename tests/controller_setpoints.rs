@@ -2,8 +2,8 @@
 
 use std::collections::BTreeMap;
 
+use dressform::form::setpoints::{FORMAT, SetPoints};
 use dressform::input::InputError;
-use dressform::setpoints::{FORMAT, SetPoints};
 use form_description::reference;
 
 fn write(dir: &tempfile::TempDir, text: &str) -> std::path::PathBuf {

@@ -6,13 +6,13 @@
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use dressform::controller::simulated::{SimConfig, SimDriveError, drive_on_sim};
-use dressform::controller::transport::sim::SimBus;
-use dressform::controller::{
+use dressform::form::controller::simulated::{SimConfig, SimDriveError, drive_on_sim};
+use dressform::form::controller::transport::sim::SimBus;
+use dressform::form::controller::{
     DriveError, DriveOptions, MoveError, NodeProblem, SessionError, StopCause, Transport,
     emergency_stop,
 };
-use dressform::setpoints::SetPoints;
+use dressform::form::setpoints::SetPoints;
 use firmware_protocol::drive::{DriveState, Faults};
 use form_description::{FormDescription, reference};
 use sim::bus::can::{CanBus, CanKind};
@@ -206,8 +206,9 @@ async fn an_emergency_stop_from_another_thread_ends_the_move_and_nothing_follows
         std::thread::spawn(move || gate.emergency_stop(StopCause::Remote).unwrap()).join().unwrap();
     });
     let options = DriveOptions::default();
-    let error =
-        dressform::controller::drive(link, &form, &setpoints, &options, |_| {}).await.unwrap_err();
+    let error = dressform::form::controller::drive(link, &form, &setpoints, &options, |_| {})
+        .await
+        .unwrap_err();
     assert!(
         matches!(error, DriveError::Session(SessionError::Stopped(StopCause::Remote))),
         "{error}"
@@ -240,7 +241,7 @@ async fn nodes_that_differ_from_the_description_are_named() {
     }
     let described = FormDescription::try_from(described).unwrap();
     let setpoints = SetPoints::new(real.name.clone(), BTreeMap::new());
-    let error = dressform::controller::drive(
+    let error = dressform::form::controller::drive(
         SimBus::attach(&bus),
         &described,
         &setpoints,

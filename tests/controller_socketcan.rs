@@ -21,8 +21,8 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use dressform::controller::transport::Transport;
-use dressform::controller::transport::socketcan::SocketCan;
+use dressform::form::controller::transport::Transport;
+use dressform::form::controller::transport::socketcan::SocketCan;
 use embedded_can::Frame as _;
 use firmware_protocol::message::Sync;
 use firmware_protocol::{Message, Packet};

@@ -5,7 +5,7 @@
 //! `fit.json` holds no wall time.
 
 use crate::common::{output_files, surface_mesh};
-use dressform::scan::format::Format;
+use dressform::body::scan::format::Format;
 use sim::capture::{Artifacts, BodyParams, capture, generate};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;

@@ -2,12 +2,12 @@
 //! matches the mannequin's within 2 mm with identical left/right set-points; beyond it, the
 //! saturated rings and their excess are reported and no set-point leaves its stroke.
 
-use dressform::fitting::fit;
-use dressform::mannequin::MannequinOptions;
-use dressform::mesh::Mesh;
-use dressform::pipeline::symmetrize;
-use dressform::profiles::Profiles;
-use dressform::scan::{self, frame::FrameOptions};
+use dressform::body::mesh::Mesh;
+use dressform::body::scan::{self, frame::FrameOptions};
+use dressform::form::form_fit::fit;
+use dressform::run::pipeline::symmetrize;
+use dressform::shape::mannequin::MannequinOptions;
+use dressform::shape::profiles::Profiles;
 use form_description::reference;
 use glam::DVec3;
 use sim::capture::{BodyParams, generate};
@@ -24,7 +24,7 @@ fn profiles_of(params: &BodyParams) -> Profiles {
     Profiles::of(&out.mannequin, &out.comparison.levels)
 }
 
-fn assert_within_strokes(fit: &dressform::fitting::Fit) {
+fn assert_within_strokes(fit: &dressform::form::form_fit::FormFit) {
     let form = reference();
     for a in &form.actuators {
         let e = fit.positions_mm[&a.id];

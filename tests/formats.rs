@@ -1,9 +1,9 @@
 //! Round trips through every mesh format we read and write, reading the variants we only read
 //! (ASCII and big-endian PLY, ASCII STL), and exports for CAD in every unit and up axis.
 
-use dressform::mesh::Mesh;
-use dressform::scan::format::{Export, Format, Placement, UpAxis, comment_value};
-use dressform::scan::frame::Units;
+use dressform::body::mesh::Mesh;
+use dressform::body::scan::format::{Export, Format, Placement, UpAxis, comment_value};
+use dressform::body::scan::frame::Units;
 use glam::DVec3;
 use std::fmt::Write as _;
 

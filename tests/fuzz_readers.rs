@@ -1,8 +1,8 @@
 //! Fuzz-style property tests: no reader panics, whatever the bytes — random bytes, valid files
 //! cut short, and valid files with bytes flipped. (Errors are fine; panics are not.)
 
-use dressform::mesh::Mesh;
-use dressform::scan::format::Format;
+use dressform::body::mesh::Mesh;
+use dressform::body::scan::format::Format;
 use glam::DVec3;
 use proptest::prelude::*;
 
@@ -76,7 +76,7 @@ proptest! {
             // Whatever a reader accepts has every index in range.
             let n = mesh.positions.len() as u32;
             prop_assert!(mesh.triangles.iter().flatten().all(|&i| i < n));
-            let _ = dressform::scan::from_mesh(mesh, std::path::Path::new("fuzz"), &Default::default());
+            let _ = dressform::body::scan::from_mesh(mesh, std::path::Path::new("fuzz"), &Default::default());
         }
     }
 

@@ -1,8 +1,8 @@
-//! The MakeHuman assets and posing with the full 163-bone rig (`dressform::makehuman`).
+//! The MakeHuman assets and posing with the full 163-bone rig (`dressform::pose::makehuman`).
 
 use crate::common;
-use dressform::makehuman::{MakeHuman, Pose, Target};
-use dressform::mesh::topology;
+use dressform::body::mesh::topology;
+use dressform::pose::makehuman::{MakeHuman, Pose, Target};
 use glam::DVec3;
 use std::path::Path;
 
@@ -148,8 +148,9 @@ fn an_asymmetric_pose_stays_closed_and_manifold() {
         .rotate("head", DVec3::new(0.2, 0.0, -0.4))
         .translate(DVec3::new(0.0, 0.0, 1000.0));
     let skin = mh.base.skin(&mh.pose(&body, &pose).unwrap());
-    let scan = dressform::scan::from_mesh(skin.clone(), Path::new("posed"), &Default::default())
-        .expect("a posed body is a valid scan");
+    let scan =
+        dressform::body::scan::from_mesh(skin.clone(), Path::new("posed"), &Default::default())
+            .expect("a posed body is a valid scan");
     assert_eq!(scan.cleaning.welded_vertices, 0, "{:?}", scan.cleaning);
     assert_eq!(scan.cleaning.degenerate_triangles, 0, "{:?}", scan.cleaning);
     assert_eq!(scan.body.triangles.len(), skin.triangles.len());

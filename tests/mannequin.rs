@@ -5,11 +5,11 @@
 use crate::common;
 
 use common::{SurfaceDistance, dressform, largest_mirror_gap, makehuman};
-use dressform::mannequin::MannequinOptions;
-use dressform::mesh::topology;
-use dressform::pipeline::symmetrize;
-use dressform::scan::{self, frame::FrameOptions};
-use dressform::symmetry::Preserve;
+use dressform::body::mesh::topology;
+use dressform::body::scan::{self, frame::FrameOptions};
+use dressform::run::pipeline::symmetrize;
+use dressform::shape::mannequin::MannequinOptions;
+use dressform::shape::symmetry::Preserve;
 use glam::DVec3;
 use std::path::Path;
 
@@ -92,7 +92,7 @@ fn symmetrize_writes_the_three_outputs_in_either_frame() {
     assert_eq!(measurements["mirrored"].as_array().unwrap().len(), 4);
 
     // Canonical frame: mm, Z up, floor at 0; --scan-frame: back in decimetres, Y up.
-    let canonical = dressform::scan::read_mesh(&out.path().join("mannequin.obj")).unwrap().0;
+    let canonical = dressform::body::scan::read_mesh(&out.path().join("mannequin.obj")).unwrap().0;
     let b = canonical.bounds().unwrap();
     assert!(b.min.z > 100.0 && b.max.z < 1500.0, "ankles to neck in mm: {b:?}");
     let (code, _, stderr) = symmetrize_cli(&[
@@ -103,7 +103,7 @@ fn symmetrize_writes_the_three_outputs_in_either_frame() {
         "--json",
     ]);
     assert_eq!(code, 0, "{stderr}");
-    let scan_frame = dressform::scan::read_mesh(&out.path().join("mannequin.obj")).unwrap().0;
+    let scan_frame = dressform::body::scan::read_mesh(&out.path().join("mannequin.obj")).unwrap().0;
     let frame = scan::load(&base, &FrameOptions::default()).unwrap().frame;
     assert!(scan_frame.bounds().unwrap().size().y > 10.0, "decimetres, Y up");
     // Both files are rounded to 0.001 mm (in their own units): within 0.002 mm of each other.
@@ -142,7 +142,7 @@ fn options_change_the_layer_and_ray_counts() {
 
 /// A closed ellipsoid "body" of human height, without legs or arms.
 fn ellipsoid(dir: &Path) -> std::path::PathBuf {
-    let mut mesh = dressform::mesh::Mesh::default();
+    let mut mesh = dressform::body::mesh::Mesh::default();
     let (n, m) = (48u32, 24u32);
     mesh.positions.push(DVec3::new(0.0, 0.0, 0.0));
     for j in 1..m {
@@ -167,8 +167,11 @@ fn ellipsoid(dir: &Path) -> std::path::PathBuf {
         mesh.triangles.push([ring(m - 1, i), ring(m - 1, i + 1), (m - 1) * n + 1]);
     }
     let path = dir.join("egg.ply");
-    dressform::output::write_atomically(&path, &dressform::scan::format::Format::Ply.encode(&mesh))
-        .unwrap();
+    dressform::atomic_output::write_atomically(
+        &path,
+        &dressform::body::scan::format::Format::Ply.encode(&mesh),
+    )
+    .unwrap();
     path
 }
 

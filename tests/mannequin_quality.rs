@@ -13,16 +13,16 @@ use common::quality::{
     self_intersecting_pairs, silhouette_top, width_jump,
 };
 use common::{largest_mirror_gap, makehuman, surface_mesh as mesh_of};
-use dressform::body_model::BodyModel;
-use dressform::makehuman::{MakeHuman, Pose as MhPose};
-use dressform::mannequin::{Layer, Mannequin, MannequinOptions};
-use dressform::mesh::{Mesh, smooth::DEFAULT_PASSES};
-use dressform::pipeline::{Symmetrized, symmetrize};
-use dressform::reconstruct::{ReconstructOptions, reconstruct};
-use dressform::regions::Region;
-use dressform::scan::{self, Scan, format::Format, frame::FrameOptions};
-use dressform::segmented_body::SegmentedBody;
-use dressform::slice::Contour;
+use dressform::body::mesh::{Mesh, smooth::DEFAULT_PASSES};
+use dressform::body::regions::Region;
+use dressform::body::scan::{self, Scan, format::Format, frame::FrameOptions};
+use dressform::body::segmented_body::SegmentedBody;
+use dressform::body::slice::Contour;
+use dressform::pose::body_model::BodyModel;
+use dressform::pose::makehuman::{MakeHuman, Pose as MhPose};
+use dressform::run::pipeline::{Symmetrized, symmetrize};
+use dressform::run::reconstruct::{ReconstructOptions, reconstruct};
+use dressform::shape::mannequin::{Layer, Mannequin, MannequinOptions};
 use glam::DVec3;
 use rayon::prelude::*;
 use sim::capture::{Artifacts, BodyParams, Pose, SyntheticBody, capture, generate};
@@ -373,7 +373,7 @@ fn report(case: &Case, out: &Symmetrized) -> Report {
     let heights: Vec<f64> = m.torso.iter().map(|l| l.z).collect();
     let scan = SegmentedBody::with_regions(&case.scan.body, &out.regions);
     let input = scan.torso_sections(&heights);
-    let ours = dressform::measure::central_loops(&m.mesh, m.axis, &heights);
+    let ours = dressform::shape::measure::central_loops(&m.mesh, m.axis, &heights);
     // Below the shoulder cap every layer keeps its section's girth; within it the mesh's
     // rings are bent over the shoulders, and its horizontal sections are reported.
     let shoulders = lm.left_armhole.shoulder_point.z.min(lm.right_armhole.shoulder_point.z);
@@ -392,7 +392,7 @@ fn report(case: &Case, out: &Symmetrized) -> Report {
     }
     let above: Vec<f64> =
         (0..).map(|k| shoulders + SLICE_STEP_MM * k as f64).take_while(|&z| z < lm.neck).collect();
-    let largest_jump = |loops: &[Option<dressform::slice::Contour>]| {
+    let largest_jump = |loops: &[Option<dressform::body::slice::Contour>]| {
         let w: Vec<f64> = loops
             .iter()
             .flatten()

@@ -10,15 +10,15 @@
 use crate::common;
 
 use common::{dressform, mesh_of};
-use dressform::measure::{
+use dressform::atomic_output::write_atomically;
+use dressform::body::regions::Landmarks;
+use dressform::body::scan::format::Format;
+use dressform::body::segmented_body::SegmentedBody;
+use dressform::body::slice::Contour;
+use dressform::shape::measure::{
     ArmMeasures, BodyDimensions, NeckAndShoulders, across_back_and_front, arms, dimensions,
     find_levels, levels, neck_and_shoulders, tape_arc, underbust,
 };
-use dressform::output::write_atomically;
-use dressform::regions::Landmarks;
-use dressform::scan::format::Format;
-use dressform::segmented_body::SegmentedBody;
-use dressform::slice::Contour;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use sim::capture::{BodyParams, SyntheticBody, generate};
@@ -97,7 +97,7 @@ fn midline_truth(body: &SyntheticBody, centre_x: f64, from: f64, to: f64, front:
             let points =
                 body.section_across([c[0], c[1], z], [0.0, 0.0, 1.0]).expect("inside the torso");
             let y = (points.iter())
-                .filter(|p| (p[0] - centre_x).abs() <= dressform::measure::MIDLINE_BAND_MM)
+                .filter(|p| (p[0] - centre_x).abs() <= dressform::shape::measure::MIDLINE_BAND_MM)
                 .map(|p| sign * p[1])
                 .fold(f64::NEG_INFINITY, f64::max);
             DVec2::new(sign * y, z)
@@ -132,8 +132,8 @@ fn compare(
         body.girth_around(body.leg_axis_at(left, z), z).expect("inside the leg")
     };
     let h = t.height_mm;
-    let thigh_z = crotch - dressform::measure::THIGH_BELOW_CROTCH * h;
-    let knee_z = dressform::measure::KNEE_OF_CROTCH * crotch;
+    let thigh_z = crotch - dressform::shape::measure::THIGH_BELOW_CROTCH * h;
+    let knee_z = dressform::shape::measure::KNEE_OF_CROTCH * crotch;
     let mut rows = vec![
         ("stature".to_string(), d.stature_mm, h),
         ("inside leg".into(), d.inside_leg_mm, t.crotch_height_mm),
@@ -187,7 +187,7 @@ fn compare(
         ));
     }
     for (left, name) in [(true, "left"), (false, "right")] {
-        let pick = |b: &dressform::measure::Bilateral| if left { b.left } else { b.right };
+        let pick = |b: &dressform::shape::measure::Bilateral| if left { b.left } else { b.right };
         rows.push((format!("{name} thigh"), pick(&d.thigh_girth_mm), leg(left, thigh_z)));
         rows.push((format!("{name} knee"), pick(&d.knee_girth_mm), leg(left, knee_z)));
         rows.push((format!("{name} ankle"), pick(&d.ankle_girth_mm), leg(left, m.ankle)));
@@ -196,7 +196,7 @@ fn compare(
         // Arms: the girths across the axis where the rules took them, on the implicit
         // surface; the length against the generator's joints (shoulder point to elbow to wrist).
         let a = arm[usize::from(!left)].as_ref().expect("an A-posed arm is measured");
-        let across = |s: &dressform::measure::ArmSection| {
+        let across = |s: &dressform::shape::measure::ArmSection| {
             body.girth_across(s.centre.to_array(), s.axis.to_array()).expect("inside the arm")
         };
         rows.push((format!("{name} upper arm"), pick(&d.upper_arm_girth_mm), across(&a.upper_arm)));
@@ -369,7 +369,7 @@ fn a_level_taken_from_a_proportion_is_reported() {
 #[test]
 fn the_underbust_is_the_fold_under_the_bust_even_below_a_chest_level_at_the_armpits() {
     let Some(dir) = common::makehuman() else { return };
-    let scan = dressform::scan::load(&dir.join("base.obj"), &Default::default()).unwrap();
+    let scan = dressform::body::scan::load(&dir.join("base.obj"), &Default::default()).unwrap();
     let segmented = SegmentedBody::find(&scan.body).unwrap();
     let d = dimensions(&segmented, &levels(&segmented));
     eprintln!("chest {:.1} mm, underbust {:.1} mm", d.chest_girth_mm, d.underbust_girth_mm);

@@ -4,7 +4,7 @@
 use crate::common;
 
 use common::{dressform, output_files, synthetic_scan};
-use dressform::scan::format::{Format, comment_value};
+use dressform::body::scan::format::{Format, comment_value};
 use glam::DVec3;
 
 fn symmetrize(args: &[&str]) -> (i32, String, String) {
@@ -21,7 +21,7 @@ fn glb_for_cad_and_the_set_replaced_as_a_whole() {
     let out_s = out.to_str().unwrap();
     let (code, _, stderr) = symmetrize(&[scan, "-o", out_s]);
     assert_eq!(code, 0, "{stderr}");
-    let obj = dressform::scan::read_mesh_file(&out.join("mannequin.obj")).unwrap().0;
+    let obj = dressform::body::scan::read_mesh_file(&out.join("mannequin.obj")).unwrap().0;
     assert_eq!(comment_value(&obj.comments, "units"), Some("mm"));
 
     let args = [scan, "-o", out_s, "--format", "glb", "--units", "m", "--up", "y"];
@@ -33,7 +33,7 @@ fn glb_for_cad_and_the_set_replaced_as_a_whole() {
         ["mannequin.glb", "measurements.json", "preview.png", "profiles.json", "sections.svg"],
         "no mannequin.obj left"
     );
-    let glb = dressform::scan::read_mesh_file(&out.join("mannequin.glb")).unwrap().0;
+    let glb = dressform::body::scan::read_mesh_file(&out.join("mannequin.glb")).unwrap().0;
     assert_eq!(comment_value(&glb.comments, "up"), Some("+y"));
     // The same mannequin: metres and Y up (x, y, z) -> (x, z, -y) in mm, Z up; f32 in the glb.
     assert_eq!(glb.mesh.triangles, obj.mesh.triangles);
@@ -58,7 +58,7 @@ fn glb_for_cad_and_the_set_replaced_as_a_whole() {
     // PLY in centimetres, Z up: read back with its header.
     let (code, _, stderr) = symmetrize(&[scan, "-o", out_s, "--format", "ply", "--units", "cm"]);
     assert_eq!(code, 0, "{stderr}");
-    let ply = dressform::scan::read_mesh_file(&out.join("mannequin.ply")).unwrap();
+    let ply = dressform::body::scan::read_mesh_file(&out.join("mannequin.ply")).unwrap();
     assert_eq!(ply.1, Format::Ply);
     assert_eq!(comment_value(&ply.0.comments, "units"), Some("cm"));
     assert!(!out.join("mannequin.glb").exists());

@@ -6,10 +6,10 @@
 
 use crate::common;
 use common::frontal::{abduction, elevation};
-use dressform::body_model::BodyModel;
-use dressform::fit::{self, FitOptions};
-use dressform::makehuman::{MakeHuman, Pose};
-use dressform::mesh::Mesh;
+use dressform::body::mesh::Mesh;
+use dressform::pose::body_model::BodyModel;
+use dressform::pose::makehuman::{MakeHuman, Pose};
+use dressform::pose::model_fit::{self, FitOptions};
 use glam::DVec3;
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
@@ -103,9 +103,12 @@ fn arm_and_leg_abduction_are_recovered_from_makehuman_scans() {
         let (points, normals) = scan_of(&mh.base.skin(&posed), &mut rng);
         let truth = mh.rig.bone_heads(&posed);
         let start = std::time::Instant::now();
-        let fitted =
-            fit::fit(&model, &fit::ScanPoints::of_cloud(&points, normals), &FitOptions::default())
-                .unwrap();
+        let fitted = model_fit::fit(
+            &model,
+            &model_fit::ScanPoints::of_cloud(&points, normals),
+            &FitOptions::default(),
+        )
+        .unwrap();
         let seconds = start.elapsed().as_secs_f64();
         let joints = fitted.joints(&model);
         let mut line = format!(
@@ -166,7 +169,7 @@ fn write_obj(mesh: &Mesh, path: &std::path::Path, metres_y_up: bool) {
     } else {
         mesh.clone()
     };
-    std::fs::write(path, dressform::scan::format::Format::Obj.encode(&placed)).unwrap();
+    std::fs::write(path, dressform::body::scan::format::Format::Obj.encode(&placed)).unwrap();
 }
 
 /// Chest, waist and hip tape girths of a `measurements.json` row set.
@@ -180,14 +183,14 @@ fn girths(json: &serde_json::Value, pointer: &str) -> Vec<f64> {
 /// The tape girths of the torso loop of the scan `path` at `heights` (canonical frame), after
 /// `smooth` Taubin passes.
 fn torso_girths(path: &std::path::Path, heights: &[f64], smooth: usize) -> Vec<f64> {
-    let mut scan = dressform::scan::load(path, &Default::default()).unwrap();
+    let mut scan = dressform::body::scan::load(path, &Default::default()).unwrap();
     scan.body.taubin_smooth(smooth);
     section_girths(&scan.body, heights)
 }
 
 /// The tape girths of `body`'s loop around the midline at `heights`.
 fn section_girths(body: &Mesh, heights: &[f64]) -> Vec<f64> {
-    dressform::measure::central_loops(body, 0.0, heights)
+    dressform::shape::measure::central_loops(body, 0.0, heights)
         .into_iter()
         .map(|c| c.map_or(f64::NAN, |c| c.tape_girth()))
         .collect()
@@ -289,11 +292,11 @@ fn reconstruct_makes_posed_makehuman_bodies_pose_symmetric() {
             .map(|m| z(&reference, &format!("/input/{m}/z_mm")))
             .collect();
         levels[0] = levels[0].min(z(&measured, "/pose_symmetric/input/chest/z_mm"));
-        let want = torso_girths(&rest_obj, &levels, dressform::mesh::smooth::DEFAULT_PASSES);
+        let want = torso_girths(&rest_obj, &levels, dressform::body::mesh::smooth::DEFAULT_PASSES);
         // posed.obj as written (the input scan's canonical frame, its floor kept), not placed
         // anew: a scanner cuts the soles at the floor, so the re-posed scan's lowest point is
         // not a floor.
-        let (posed, _) = dressform::scan::read_mesh(&out_dir.join("posed.obj")).unwrap();
+        let (posed, _) = dressform::body::scan::read_mesh(&out_dir.join("posed.obj")).unwrap();
         let got = section_girths(&posed, &levels);
         let table = girths(&measured, "/pose_symmetric/input");
         eprintln!(

@@ -10,12 +10,12 @@
 use crate::common;
 use common::Cuts;
 use common::frontal::{abduction, elevation};
-use dressform::body_model::BodyModel;
-use dressform::makehuman::{MakeHuman, Pose};
-use dressform::measure::{central_loops, levels};
-use dressform::mesh::Mesh;
-use dressform::reconstruct::{ReconstructOptions, reconstruct};
-use dressform::segmented_body::SegmentedBody;
+use dressform::body::mesh::Mesh;
+use dressform::body::segmented_body::SegmentedBody;
+use dressform::pose::body_model::BodyModel;
+use dressform::pose::makehuman::{MakeHuman, Pose};
+use dressform::run::reconstruct::{ReconstructOptions, reconstruct};
+use dressform::shape::measure::{central_loops, levels};
 use glam::{DQuat, DVec3};
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
@@ -226,14 +226,14 @@ fn exceeds(error: f64, limit: f64) -> bool {
 }
 
 fn write_obj(mesh: &Mesh, path: &Path) {
-    std::fs::write(path, dressform::scan::format::Format::Obj.encode(mesh)).unwrap();
+    std::fs::write(path, dressform::body::scan::format::Format::Obj.encode(mesh)).unwrap();
 }
 
 /// A scan file read as the commands read it: into the canonical frame, then Taubin-smoothed
 /// (`--smooth`'s default).
-fn load(path: &Path) -> dressform::scan::Scan {
-    let mut scan = dressform::scan::load(path, &Default::default()).unwrap();
-    scan.body.taubin_smooth(dressform::mesh::smooth::DEFAULT_PASSES);
+fn load(path: &Path) -> dressform::body::scan::Scan {
+    let mut scan = dressform::body::scan::load(path, &Default::default()).unwrap();
+    scan.body.taubin_smooth(dressform::body::mesh::smooth::DEFAULT_PASSES);
     scan
 }
 
@@ -290,7 +290,7 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         let mut rng = ChaCha8Rng::seed_from_u64(2500 + i as u64);
         let remeshed = |name: &str| {
             let path = tmp.path().join(format!("{name}{i}.ply"));
-            dressform::scan::read_mesh(&path).unwrap().0
+            dressform::body::scan::read_mesh(&path).unwrap().0
         };
         let [(heads, floor), (truth_heads, truth_floor)] = [&bodies[0], &bodies[1]];
         let joint = |name: &str| heads[mh.rig.bone(name).unwrap()];
@@ -474,7 +474,7 @@ fn reconstruct_straightens_the_sim_generators_asymmetric_bodies() {
         let body = generate(params).expect("the body generates");
         let path = tmp.path().join(format!("{name}.ply"));
         let mesh = common::surface_mesh(&capture(&body, &Artifacts::typical_scanner(7)));
-        std::fs::write(&path, dressform::scan::format::Format::Ply.encode(&mesh)).unwrap();
+        std::fs::write(&path, dressform::body::scan::format::Format::Ply.encode(&mesh)).unwrap();
         load(&path)
     };
     let mut poses = Vec::new();

@@ -10,8 +10,8 @@
 //! hanging fingertip 0.417-0.435 over every +-2 sd body: no shape coefficient reaches a real arm.
 
 use crate::common;
-use dressform::body_model::BodyModel;
-use dressform::makehuman::MakeHuman;
+use dressform::pose::body_model::BodyModel;
+use dressform::pose::makehuman::MakeHuman;
 use glam::DVec3;
 
 /// Winter's ratios of stature (Drillis & Contini): the segments' lengths (upper arm, forearm,

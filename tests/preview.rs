@@ -4,7 +4,7 @@
 
 use crate::common;
 
-use dressform::scan::format::Format;
+use dressform::body::scan::format::Format;
 use sim::capture::{BodyParams, generate};
 
 /// The level lines' colours in the preview (chest, waist, hip), as documented in

@@ -3,9 +3,9 @@
 //! adapter), and the `dressform` binary opening that device — then the simulated actuators are
 //! checked against the set-points the run wrote.
 
-use dressform::mesh::Mesh;
-use dressform::scan::format::Format;
-use dressform::setpoints::SetPoints;
+use dressform::body::mesh::Mesh;
+use dressform::body::scan::format::Format;
+use dressform::form::setpoints::SetPoints;
 use form_description::reference;
 use glam::DVec3;
 use sim::capture::{Artifacts, BodyParams, capture, generate};

@@ -5,9 +5,9 @@
 use crate::common;
 
 use common::{makehuman, mesh_of};
-use dressform::regions::Armhole;
-use dressform::scan::{self, frame::FrameOptions};
-use dressform::segmented_body::SegmentedBody;
+use dressform::body::regions::Armhole;
+use dressform::body::scan::{self, frame::FrameOptions};
+use dressform::body::segmented_body::SegmentedBody;
 use glam::DVec3;
 use sim::capture::{BodyParams, Pose, generate};
 
@@ -57,7 +57,7 @@ fn torso_shape(body: &SegmentedBody) -> TorsoShape {
 fn makehuman_joint(
     dir: &std::path::Path,
     name: &str,
-    frame: &dressform::scan::frame::CanonicalFrame,
+    frame: &dressform::body::scan::frame::CanonicalFrame,
 ) -> DVec3 {
     let rig: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("rigs/default.mhskel")).unwrap())

@@ -1,6 +1,6 @@
 //! Segmentation and the chest, waist and hip girths on MakeHuman bodies (`../shared/makehuman`):
 //! 10 random bodies from its targets, posed with its own 163-bone rig and skin weights
-//! (`dressform::makehuman`, linear blend skinning) in the slightly asymmetric range (one arm
+//! (`dressform::pose::makehuman`, linear blend skinning) in the slightly asymmetric range (one arm
 //! 10-20 degrees further out, one shoulder lifted 3-8 degrees, one leg 3-8 degrees out, the
 //! spine bent sideways 3-6 degrees and twisted, the head turned), then given a scanner's
 //! artifacts (1 mm of noise, holes at the armpits, crotch and soles). Every one segments and
@@ -8,14 +8,14 @@
 //! case is printed.
 
 use crate::common::{self, uniform};
-use dressform::makehuman::{MakeHuman, Pose};
-use dressform::mannequin::MannequinOptions;
-use dressform::measure::{Measurements, levels, measure_at};
-use dressform::mesh::Mesh;
-use dressform::pipeline::symmetrize;
-use dressform::regions::Landmarks;
-use dressform::scan::{self, Scan};
-use dressform::segmented_body::SegmentedBody;
+use dressform::body::mesh::Mesh;
+use dressform::body::regions::Landmarks;
+use dressform::body::scan::{self, Scan};
+use dressform::body::segmented_body::SegmentedBody;
+use dressform::pose::makehuman::{MakeHuman, Pose};
+use dressform::run::pipeline::symmetrize;
+use dressform::shape::mannequin::MannequinOptions;
+use dressform::shape::measure::{Measurements, levels, measure_at};
 use glam::DVec3;
 use rayon::prelude::*;
 use sim::capture::{TriangleSurface, with_noise_and_holes};

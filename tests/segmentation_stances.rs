@@ -10,9 +10,9 @@
 //! (15 mm for an arm held out horizontally). The worst case of each stance is printed.
 
 use crate::common::{mesh_of, uniform};
-use dressform::measure::{levels, measure_at};
-use dressform::regions::Armhole;
-use dressform::segmented_body::SegmentedBody;
+use dressform::body::regions::Armhole;
+use dressform::body::segmented_body::SegmentedBody;
+use dressform::shape::measure::{levels, measure_at};
 use glam::DVec3;
 use rayon::prelude::*;
 use sim::capture::{BodyParams, generate};
@@ -36,7 +36,7 @@ const PLATE_MM: f64 = 15.0;
 
 /// How far a found armpit may lie from the generator's design armpit (mm). An arm resting on
 /// the torso hides its armpit in the contact; the rule that finds it there
-/// (`dressform::regions::Contact`) lands within 9 mm of the design point.
+/// (`dressform::body::regions::Contact`) lands within 9 mm of the design point.
 const ARMPIT_TOLERANCE_MM: f64 = 10.0;
 /// The same for an arm held out horizontally: it grows out of the torso's side with no loop
 /// of its own below, and its armpit is the crease where the side's reach jumps, up to 15 mm

@@ -5,8 +5,8 @@
 //!   pose and the corners of the allowed ranges; the arms are loops of their own;
 //! - scans: each hole a scanner leaves is one simple boundary loop at its site.
 
-use dressform::mesh::{Mesh, Topology, components, topology};
-use dressform::slice::{Contour, Section, sections};
+use dressform::body::mesh::{Mesh, Topology, components, topology};
+use dressform::body::slice::{Contour, Section, sections};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use sim::capture::{

@@ -5,10 +5,10 @@
 use crate::common;
 
 use common::{largest_mirror_gap, surface_mesh as mesh_of};
-use dressform::mannequin::MannequinOptions;
-use dressform::mesh::topology;
-use dressform::pipeline::symmetrize;
-use dressform::scan::{self, frame::FrameOptions};
+use dressform::body::mesh::topology;
+use dressform::body::scan::{self, frame::FrameOptions};
+use dressform::run::pipeline::symmetrize;
+use dressform::shape::mannequin::MannequinOptions;
 use sim::capture::{Artifacts, BodyParams, Pose, capture, generate};
 use std::path::Path;
 
@@ -49,7 +49,7 @@ fn a_scan_with_artifacts_gives_the_customers_measurements() {
         scan::from_mesh(mesh_of(&raw), Path::new("typical scan"), &FrameOptions::default())
             .unwrap();
     assert!(!topology(&scan.body).is_closed(), "the scanner left holes");
-    scan.body.taubin_smooth(dressform::mesh::smooth::DEFAULT_PASSES);
+    scan.body.taubin_smooth(dressform::body::mesh::smooth::DEFAULT_PASSES);
     let out = symmetrize(&scan, &MannequinOptions::default(), |_| {}).unwrap();
     // ISO 20685-1 allows 4 mm for the height.
     let height = out.comparison.input.height;

@@ -7,15 +7,15 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Duration;
 
-use dressform::controller::motion::MAX_SLOWER;
-use dressform::controller::simulated::SimConfig;
-use dressform::controller::{
+use dressform::form::controller::motion::MAX_SLOWER;
+use dressform::form::controller::simulated::SimConfig;
+use dressform::form::controller::{
     Claim, DEFAULT_TOLERANCE_MM, DriveError, DriveOptions, DriveReport, LinkSpec, MoveError,
     Progress, SessionError, plan,
 };
-use dressform::fitting::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
+use dressform::form::form_fit::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
+use dressform::form::setpoints::SetPoints;
 use dressform::messages;
-use dressform::setpoints::SetPoints;
 use firmware_protocol::Position;
 use firmware_protocol::message::Sync;
 use form_description::FormDescription;

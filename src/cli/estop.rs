@@ -12,10 +12,10 @@
 
 use super::Failure;
 use super::link::{self, FormArg, LinkArgs, runtime};
-use dressform::controller::open::OpenLink;
-use dressform::controller::simulated::SimConfig;
-use dressform::controller::transport::shared_stop_gate;
-use dressform::controller::{
+use dressform::form::controller::open::OpenLink;
+use dressform::form::controller::simulated::SimConfig;
+use dressform::form::controller::transport::shared_stop_gate;
+use dressform::form::controller::{
     Connection, LinkSpec, StopCause, control, emergency_stop, fault_names,
 };
 use std::time::Duration;

@@ -4,7 +4,7 @@
 
 use super::Failure;
 use super::link::FormArg;
-use dressform::fitting::ring_girth;
+use dressform::form::form_fit::ring_girth;
 use form_description::{FormDescription, REFERENCE_TOML};
 use std::collections::BTreeMap;
 

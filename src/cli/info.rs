@@ -1,8 +1,8 @@
 //! `dressform info <scan> [--json]`.
 
 use super::{Failure, FrameArgs, warn};
-use dressform::report::ScanInfo;
-use dressform::scan;
+use dressform::body::scan;
+use dressform::run::info::ScanInfo;
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]

@@ -4,10 +4,10 @@
 
 use std::path::PathBuf;
 
-use dressform::controller::control::Endpoint;
-use dressform::controller::open::{OpenError, OpenLink};
-use dressform::controller::simulated::{SimConfig, SimDriveError, SimulatedRig};
-use dressform::controller::{Connection, LinkSpec, Transport};
+use dressform::form::controller::control::Endpoint;
+use dressform::form::controller::open::{OpenError, OpenLink};
+use dressform::form::controller::simulated::{SimConfig, SimDriveError, SimulatedRig};
+use dressform::form::controller::{Connection, LinkSpec, Transport};
 use form_description::FormDescription;
 
 use super::Failure;

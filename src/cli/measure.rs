@@ -2,13 +2,13 @@
 //! several measured in parallel (one row each).
 
 use super::{Failure, FrameArgs, SmoothArgs, warn};
-use dressform::measure::{
+use dressform::body::regions::Landmarks;
+use dressform::body::scan;
+use dressform::body::segmented_body::SegmentedBody;
+use dressform::shape::measure::{
     BodyDimensions, Girth, Levels, Measurements, contact_warnings, dimensions, find_levels,
     measure_at, warnings,
 };
-use dressform::regions::Landmarks;
-use dressform::scan;
-use dressform::segmented_body::SegmentedBody;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -155,7 +155,7 @@ fn print_text(m: &MeasureOut, at: &[f64]) {
             outln!("  {name:<22} {v:7.1} mm")
         }
     };
-    let b = |name: &str, v: &dressform::measure::Bilateral, unit: &str| {
+    let b = |name: &str, v: &dressform::shape::measure::Bilateral, unit: &str| {
         if v.difference.is_nan() {
             // An arm raised too high to be followed down its loops.
             outln!("  {name:<22} not measured (left {:.1}, right {:.1} {unit})", v.left, v.right)

@@ -45,12 +45,12 @@ mod symmetrize;
 
 use clap::builder::{PossibleValue, PossibleValuesParser, RangedU64ValueParser, TypedValueParser};
 use clap::{Parser, Subcommand};
-use dressform::mesh::smooth;
+use dressform::body::mesh::smooth;
+use dressform::body::scan::Scan;
+use dressform::body::scan::format::{Export, Format, Placement, UpAxis};
+use dressform::body::scan::frame::{Direction, FrameOptions, Units};
 use dressform::messages;
-use dressform::scan::Scan;
-use dressform::scan::format::{Export, Format, Placement, UpAxis};
-use dressform::scan::frame::{Direction, FrameOptions, Units};
-use dressform::symmetry::Preserve;
+use dressform::shape::symmetry::Preserve;
 use std::io::{ErrorKind, Write};
 use std::ops::{Bound, RangeBounds};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -80,7 +80,7 @@ enum Command {
     /// Scan to shaped form in one command: mannequin, set-points, drive, girth report.
     Run(run::RunArgs),
     /// Start a simulated robotic form on a pseudo-terminal and print its device path.
-    Sim(sim::SimArgs),
+    Sim(sim::ServeArgs),
     /// Run the pipeline on a built-in synthetic customer, no files or hardware needed.
     Demo(demo::DemoArgs),
     /// Drive the robotic form to a set-point file, all actuators together, with live progress.
@@ -200,8 +200,8 @@ pub struct MannequinArgs {
 }
 
 impl MannequinArgs {
-    fn options(&self) -> dressform::mannequin::MannequinOptions {
-        dressform::mannequin::MannequinOptions {
+    fn options(&self) -> dressform::shape::mannequin::MannequinOptions {
+        dressform::shape::mannequin::MannequinOptions {
             torso_layers: self.torso_layers,
             leg_layers: self.leg_layers,
             rays: self.rays,

@@ -1,10 +1,10 @@
 //! `dressform model build|info|sample`: the statistical body model (paper 3.1.1).
 
 use super::{Failure, progress_bar, within};
-use dressform::body_model::{self, BodyModel, BuildOptions, MAX_BETA, file};
-use dressform::makehuman::MakeHuman;
-use dressform::output::write_atomically;
-use dressform::scan::{self, format::Format};
+use dressform::atomic_output::write_atomically;
+use dressform::body::scan::{self, format::Format};
+use dressform::pose::body_model::{self, BodyModel, BuildOptions, MAX_BETA, file};
+use dressform::pose::makehuman::MakeHuman;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]
@@ -140,7 +140,7 @@ fn build(args: &BuildArgs) -> Result<(), Failure> {
 fn read_meshes(
     dir: &Path,
     template: &BodyModel,
-    progress: body_model::Progress,
+    progress: body_model::BuildProgress,
 ) -> Result<Vec<Vec<glam::DVec3>>, Failure> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| Failure::bad_input(format!("{}: cannot read: {e}", dir.display())))?

@@ -1,16 +1,16 @@
 //! `dressform reconstruct <scan> -o <dir> [--model model.glb] [--pose pose.toml]
 //! [--format ...] [--units ...] [--up ...] [--scan-frame] [--json]`: pose symmetry, then the
-//! mannequin (see [`dressform::reconstruct`]).
+//! mannequin (see [`dressform::run::reconstruct`]).
 
 use super::symmetrize::pretty_json;
 use super::{ExportArgs, Failure, MannequinArgs, ScanFrameArgs, SmoothArgs, progress_bar, warn};
-use dressform::body_model::BodyModel;
-use dressform::mesh::topology;
-use dressform::outputs::Outputs;
-use dressform::pipeline;
-use dressform::pose_symmetry::PoseOverrides;
-use dressform::reconstruct::{ReconstructOptions, Reconstruction, STEPS, reconstruct};
-use dressform::scan;
+use dressform::body::mesh::topology;
+use dressform::body::scan;
+use dressform::pose::body_model::BodyModel;
+use dressform::pose::pose_symmetry::PoseOverrides;
+use dressform::run::outputs::Outputs;
+use dressform::run::pipeline;
+use dressform::run::reconstruct::{ReconstructOptions, Reconstruction, STEPS, reconstruct};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]

@@ -4,9 +4,9 @@
 
 use super::Failure;
 use super::link::{self, FormArg, LinkArgs, runtime};
-use dressform::controller::faults::describe;
-use dressform::controller::simulated::SimConfig;
-use dressform::controller::{ResetReport, reset};
+use dressform::form::controller::faults::describe;
+use dressform::form::controller::simulated::SimConfig;
+use dressform::form::controller::{ResetReport, reset};
 
 #[derive(Debug, clap::Args)]
 pub struct ResetArgs {

@@ -5,8 +5,8 @@
 
 use super::Failure;
 use super::link::FormArg;
-use dressform::fitting::{Fit, fit, regions_of};
-use dressform::profiles::Profiles;
+use dressform::form::form_fit::{FormFit, fit, regions_of};
+use dressform::shape::profiles::Profiles;
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
@@ -40,7 +40,7 @@ pub fn run(args: &SetpointsArgs) -> Result<(), Failure> {
 }
 
 /// The fidelity report as a table, with a line per ring whose shape or girth is limited.
-pub fn fidelity_table(fit: &Fit) -> String {
+pub fn fidelity_table(fit: &FormFit) -> String {
     use std::fmt::Write;
     let mut s = String::new();
     let _ = writeln!(

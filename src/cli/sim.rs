@@ -9,7 +9,7 @@ use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
 #[command(group = clap::ArgGroup::new("link").required(true))]
-pub struct SimArgs {
+pub struct ServeArgs {
     #[command(flatten)]
     form: FormArg,
     /// Speak the serial mapping (COBS + CRC) on a pseudo-terminal.
@@ -27,7 +27,7 @@ pub struct SimArgs {
     faults: Option<String>,
 }
 
-pub fn run(args: &SimArgs) -> Result<(), Failure> {
+pub fn run(args: &ServeArgs) -> Result<(), Failure> {
     let form = args.form.load()?;
     let faults = args
         .faults

@@ -1,9 +1,9 @@
 //! `dressform slice <mesh> --heights 900,950,... [--json]`.
 
 use super::{Failure, FrameArgs, warn};
-use dressform::regions::Region;
-use dressform::scan;
-use dressform::segmented_body::SegmentedBody;
+use dressform::body::regions::Region;
+use dressform::body::scan;
+use dressform::body::segmented_body::SegmentedBody;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;

@@ -5,8 +5,8 @@
 
 use std::time::Duration;
 
-use dressform::controller::simulated::SimConfig;
-use dressform::controller::{LinkSpec, NodeReport, status};
+use dressform::form::controller::simulated::SimConfig;
+use dressform::form::controller::{LinkSpec, NodeReport, status};
 
 use super::Failure;
 use super::link::{self, FormArg, LinkArgs, runtime};

@@ -3,11 +3,11 @@
 //! [--scan-frame] [--json]`.
 
 use super::{ExportArgs, Failure, MannequinArgs, ScanFrameArgs, SmoothArgs, progress_bar, warn};
-use dressform::measure::Comparison;
-use dressform::mesh::topology;
-use dressform::outputs::Outputs;
-use dressform::pipeline::{STEPS, symmetrize};
-use dressform::scan;
+use dressform::body::mesh::topology;
+use dressform::body::scan;
+use dressform::run::outputs::Outputs;
+use dressform::run::pipeline::{STEPS, symmetrize};
+use dressform::shape::measure::Comparison;
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]

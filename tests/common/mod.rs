@@ -79,7 +79,7 @@ pub fn output_files(dir: &std::path::Path) -> Vec<(String, Vec<u8>)> {
     files
 }
 
-use dressform::mesh::Mesh;
+use dressform::body::mesh::Mesh;
 use glam::DVec3;
 use std::collections::HashMap;
 
@@ -193,7 +193,8 @@ pub fn synthetic_scan(dir: &std::path::Path, seed: u64) -> PathBuf {
     let mesh =
         Mesh::new(raw.positions.iter().map(|&p| DVec3::from_array(p)).collect(), raw.triangles);
     let path = dir.join("scan.ply");
-    std::fs::write(&path, dressform::scan::format::Format::Ply.encode(&mesh)).expect("writable");
+    std::fs::write(&path, dressform::body::scan::format::Format::Ply.encode(&mesh))
+        .expect("writable");
     path
 }
 

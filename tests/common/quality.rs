@@ -3,8 +3,8 @@
 //! line of the front silhouette. Independent of the library's own geometry code, except for
 //! slicing.
 
-use dressform::mesh::Mesh;
-use dressform::slice::sections;
+use dressform::body::mesh::Mesh;
+use dressform::body::slice::sections;
 use glam::DVec3;
 use robust::{Coord, Coord3D, orient2d, orient3d};
 use rstar::RTree;

@@ -1,0 +1,507 @@
+//! The canonical body frame: millimetres, Z up, floor at z = 0, +X = the subject's left, the
+//! subject facing -Y (right-handed, as in Blender's front view), origin under the torso's
+//! centre: the bounding-box centre of the largest horizontal section at 58% of the height
+//! (the waist, which no arm pose moves). Scans arrive in any unit, with Y or Z up and turned any way about the vertical; this
+//! module finds out which, and keeps the transform so outputs can go back to the scan's frame.
+//!
+//! Detection, each step overridable:
+//! - **up**: the axis of the largest extent (a standing body is taller than wide or deep); its
+//!   sign from the area-weighted centroid, which sits above mid-height (torso, arms and head
+//!   carry more surface than the legs);
+//! - **units**: from the height — a standing person is 0.5-2.5 m tall, and that range in m,
+//!   dm, cm and mm does not overlap;
+//! - **left-right axis**: the major principal axis of the surface between hips and shoulders
+//!   (shoulders, hips and hanging arms are wider than the body is deep); exact for a
+//!   mirror-symmetric body, whatever its turn;
+//! - **front**: the side the feet point to (the lowest 4% of the body lies in front of the
+//!   shins).
+
+use crate::body::mesh::{Aabb, Mesh};
+use crate::body::slice::sections;
+use glam::{DMat3, DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
+
+/// The heights a standing person can have (mm): from a small child to the tallest adults,
+/// with margin; the ranges in m, dm, cm and mm do not overlap, so the height tells the unit.
+pub const PERSON_HEIGHT_MM: (f64, f64) = (500.0, 2500.0);
+
+/// A length unit a scan may be stored in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Units {
+    /// Metres.
+    M,
+    /// Decimetres (MakeHuman).
+    Dm,
+    /// Centimetres.
+    Cm,
+    /// Millimetres.
+    Mm,
+}
+
+impl Units {
+    /// Every unit, largest first.
+    pub const ALL: [Units; 4] = [Units::M, Units::Dm, Units::Cm, Units::Mm];
+
+    /// The unit's symbol: `m`, `dm`, `cm` or `mm` (as files, JSON and the command line spell it).
+    pub fn symbol(self) -> &'static str {
+        match self {
+            Units::M => "m",
+            Units::Dm => "dm",
+            Units::Cm => "cm",
+            Units::Mm => "mm",
+        }
+    }
+
+    /// Millimetres in one unit.
+    pub fn mm(self) -> f64 {
+        match self {
+            Units::M => 1000.0,
+            Units::Dm => 100.0,
+            Units::Cm => 10.0,
+            Units::Mm => 1.0,
+        }
+    }
+
+    /// The unit in which `height` is the height of a standing person (0.5-2.5 m).
+    pub fn from_height(height: f64) -> Option<Units> {
+        Units::ALL
+            .into_iter()
+            .find(|u| (PERSON_HEIGHT_MM.0..=PERSON_HEIGHT_MM.1).contains(&(height * u.mm())))
+    }
+}
+
+impl fmt::Display for Units {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.symbol())
+    }
+}
+
+/// A signed coordinate axis of the scan's frame: `+x`, `-y`, `z` (= `+z`), ...
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Direction {
+    axis: usize,
+    negative: bool,
+}
+
+impl Direction {
+    /// The unit vector.
+    pub fn vector(self) -> DVec3 {
+        let mut v = DVec3::ZERO;
+        v[self.axis] = if self.negative { -1.0 } else { 1.0 };
+        v
+    }
+
+    /// The signed axis that `v` points along, if it is within 1 degree of one.
+    pub fn nearest(v: DVec3) -> Option<Direction> {
+        let axis = v.abs().max_position();
+        let d = Direction { axis, negative: v[axis] < 0.0 };
+        (d.vector().dot(v.normalize_or_zero()) > 1.0f64.to_radians().cos()).then_some(d)
+    }
+}
+
+impl FromStr for Direction {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let lower = s.to_ascii_lowercase();
+        let (negative, name) = match lower.as_bytes() {
+            [b'-', rest @ ..] => (true, rest),
+            [b'+', rest @ ..] => (false, rest),
+            rest => (false, rest),
+        };
+        let axis = match name {
+            b"x" => 0,
+            b"y" => 1,
+            b"z" => 2,
+            _ => return Err(format!("'{s}' is not an axis: use x, y, z, -x, -y or -z")),
+        };
+        Ok(Direction { axis, negative })
+    }
+}
+
+impl fmt::Display for Direction {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}{}", if self.negative { '-' } else { '+' }, ["x", "y", "z"][self.axis])
+    }
+}
+
+impl Serialize for Direction {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+/// What the user says about the scan's frame; `None` means "detect it".
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FrameOptions {
+    /// The scan's length unit.
+    pub units: Option<Units>,
+    /// The scan's up direction.
+    pub up: Option<Direction>,
+    /// The direction the subject faces, in the scan's frame.
+    pub facing: Option<Direction>,
+}
+
+/// Why the canonical frame could not be established.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FrameError {
+    /// The height matches no unit for a person.
+    #[error(
+        "the body is {} units tall along {up}, which is 0.5-2.5 m in none of m, dm, cm, mm; \
+         pass --units (and check --up)", crate::messages::number(*height)
+    )]
+    UnknownUnits {
+        /// Height in the file's units.
+        height: f64,
+        /// The up direction used.
+        up: Direction,
+    },
+    /// `--units` makes the body a height no standing person has.
+    #[error(
+        "with --units {units} the body is {} mm tall, and a standing person is 500-2500 mm; \
+         {hint}", crate::messages::number(height_mm.round())
+    )]
+    ImplausibleUnits {
+        /// The unit given.
+        units: Units,
+        /// The height it gives (mm).
+        height_mm: f64,
+        /// What to do instead.
+        hint: String,
+    },
+    /// `--up` puts the head below the feet, or makes the body wider than tall.
+    #[error("with --up {up} {problem}; {hint}")]
+    ImplausibleUp {
+        /// The up direction given.
+        up: Direction,
+        /// What no standing person looks like.
+        problem: String,
+        /// What to do instead.
+        hint: String,
+    },
+    /// `--facing` along the up axis.
+    #[error("--facing {facing} is not horizontal when up is {up}")]
+    FacingNotHorizontal {
+        /// The facing given.
+        facing: Direction,
+        /// The up direction used.
+        up: Direction,
+    },
+}
+
+/// How a scan's coordinates map to the canonical frame: `canonical = R (s p) + t`.
+#[derive(Debug, Clone, Serialize)]
+pub struct CanonicalFrame {
+    /// The scan's unit.
+    pub units: Units,
+    /// Whether `units` was detected (rather than given).
+    pub units_detected: bool,
+    /// The scan's up direction.
+    pub up: Direction,
+    /// Whether `up` was detected.
+    pub up_detected: bool,
+    /// The direction the subject faces, in the scan's frame (a unit vector).
+    pub facing: DVec3,
+    /// Whether `facing` was detected.
+    pub facing_detected: bool,
+    /// How far (mm) the feet lie in front of the shins: the evidence for the facing.
+    /// Near zero means the front could not be told from the back.
+    pub facing_evidence_mm: f64,
+    /// Height of the body in mm.
+    pub height_mm: f64,
+    /// Whether the frame was stated in the file's header (a file dressform wrote, see
+    /// [`FileFrame`]) rather than detected or given.
+    pub from_header: bool,
+    #[serde(skip)]
+    rotation: DMat3,
+    #[serde(skip)]
+    translation: DVec3,
+}
+
+impl CanonicalFrame {
+    /// A scan point in the canonical frame.
+    pub fn to_canonical(&self, p: DVec3) -> DVec3 {
+        self.rotation * (p * self.units.mm()) + self.translation
+    }
+
+    /// A canonical point back in the scan's frame.
+    pub fn to_scan(&self, q: DVec3) -> DVec3 {
+        self.rotation.transpose() * (q - self.translation) / self.units.mm()
+    }
+
+    /// Moves the origin under the torso of `body` (already in this frame): the bounding-box
+    /// centre of its largest section at 58% of the height. Updates `body` and the transform.
+    pub fn centre_on_torso(&mut self, body: &mut Mesh) {
+        let z = 0.58 * self.height_mm;
+        let Some(torso) =
+            sections(body, &[z]).into_iter().next().and_then(|s| s.loops.into_iter().next())
+        else {
+            return;
+        };
+        let Some(b) = Aabb::around(torso.points.iter().map(|p| p.extend(0.0))) else { return };
+        let shift = DVec3::new(0.5 * (b.min.x + b.max.x), 0.5 * (b.min.y + b.max.y), 0.0);
+        self.translate(body, -shift);
+    }
+
+    /// Moves `body` (already in this frame) by `offset` (mm) and records the move in the
+    /// transform, so that the body still maps back to where the scan stood.
+    pub fn translate(&mut self, body: &mut Mesh, offset: DVec3) {
+        body.transform(|p| p + offset);
+        self.translation += offset;
+    }
+
+    /// The map from the scan's coordinates to this frame, as a header states it.
+    pub fn file_frame(&self) -> FileFrame {
+        FileFrame {
+            units: self.units,
+            rotation: self.rotation.transpose().to_cols_array_2d(),
+            translation: self.translation.to_array(),
+        }
+    }
+
+    /// The frame a file's header states (see [`FileFrame`]), for `mesh` in the file's
+    /// coordinates: no detection, no centring, the floor where the header puts it.
+    pub fn stated(file: &FileFrame, mesh: &Mesh) -> Result<CanonicalFrame, String> {
+        let rotation = DMat3::from_cols_array_2d(&file.rotation).transpose();
+        let orthonormal = (rotation * rotation.transpose() - DMat3::IDENTITY)
+            .to_cols_array()
+            .iter()
+            .all(|e| e.abs() <= ROTATION_TOLERANCE);
+        if !orthonormal || (rotation.determinant() - 1.0).abs() > ROTATION_TOLERANCE {
+            return Err("rotation: not a rotation matrix".to_string());
+        }
+        let translation = DVec3::from_array(file.translation);
+        if !translation.is_finite() {
+            return Err("translation_mm: not finite".to_string());
+        }
+        let up = Direction::nearest(rotation.transpose() * DVec3::Z)
+            .ok_or("rotation: the up direction is not an axis of the file")?;
+        let mut frame = CanonicalFrame {
+            units: file.units,
+            units_detected: false,
+            up,
+            up_detected: false,
+            facing: rotation.transpose() * DVec3::NEG_Y,
+            facing_detected: false,
+            facing_evidence_mm: 0.0,
+            height_mm: 0.0,
+            from_header: true,
+            rotation,
+            translation,
+        };
+        let top = mesh.positions.iter().map(|&p| frame.to_canonical(p).z).fold(0.0, f64::max);
+        frame.height_mm = top;
+        Ok(frame)
+    }
+
+    /// `facing` as an axis name when it is one (within 1 degree).
+    pub fn facing_axis(&self) -> Option<Direction> {
+        Direction::nearest(self.facing)
+    }
+}
+
+/// How a file's coordinates map to the canonical frame, as the header of a file dressform
+/// wrote states it: `canonical = rotation (p units) + translation`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FileFrame {
+    /// The file's unit.
+    pub units: Units,
+    /// The rotation, row by row.
+    pub rotation: [[f64; 3]; 3],
+    /// The translation (mm).
+    #[serde(rename = "translation_mm")]
+    pub translation: [f64; 3],
+}
+
+/// How far a stated rotation may be from orthonormal: a header writes its entries to about
+/// 17 significant digits, so only a corrupted one comes near this.
+const ROTATION_TOLERANCE: f64 = 1e-6;
+
+/// Area-weighted sums over triangle centroids: weight, first moment, and the second moments
+/// of two horizontal coordinates.
+#[derive(Debug, Clone, Copy, Default)]
+struct Moments {
+    weight: f64,
+    sum: DVec3,
+    xx: f64,
+    xy: f64,
+    yy: f64,
+}
+
+impl Moments {
+    fn add(&mut self, p: DVec3, a: f64, flat: DVec2) {
+        self.weight += a;
+        self.sum += p * a;
+        self.xx += a * flat.x * flat.x;
+        self.xy += a * flat.x * flat.y;
+        self.yy += a * flat.y * flat.y;
+    }
+
+    fn merge(mut self, o: Moments) -> Moments {
+        self.weight += o.weight;
+        self.sum += o.sum;
+        self.xx += o.xx;
+        self.xy += o.xy;
+        self.yy += o.yy;
+        self
+    }
+
+    fn mean(&self) -> Option<DVec3> {
+        (self.weight > 0.0).then(|| self.sum / self.weight)
+    }
+}
+
+/// Sums `add(moments, centroid, area)` over the triangles of `mesh`, in parallel and in a
+/// fixed order (the same bits on every run; see [`crate::body::mesh::reduce`]).
+fn accumulate<const N: usize>(
+    mesh: &Mesh,
+    add: impl Fn(&mut [Moments; N], DVec3, f64) + Sync,
+) -> [Moments; N] {
+    crate::body::mesh::reduce::fold(
+        mesh.triangles.len(),
+        || [Moments::default(); N],
+        |mut acc, t| {
+            let [a, b, c] = mesh.triangles[t].map(|v| mesh.positions[v as usize]);
+            add(&mut acc, (a + b + c) / 3.0, 0.5 * (b - a).cross(c - a).length());
+            acc
+        },
+        |x, y| std::array::from_fn(|k| x[k].merge(y[k])),
+    )
+}
+
+/// The smallest ratio of height to the largest horizontal extent of a standing person: arms
+/// spread horizontally span about the stature (arm span / stature is 0.95-1.06 in adults),
+/// so a body wider than 1.25 times its height is lying down or seen along the wrong axis.
+const MIN_HEIGHT_TO_WIDTH: f64 = 0.8;
+
+/// Checks that `up` (given by the user) shows a standing person: the surface's centroid above
+/// mid-height (torso, arms and head carry more surface than the legs) and the body no wider
+/// than a person with spread arms. `detected` is what detection would have chosen.
+fn check_up(
+    up: Direction,
+    bounds: &Aabb,
+    centroid: DVec3,
+    detected: Direction,
+) -> Result<(), FrameError> {
+    let hint = if detected == up {
+        "check that the file holds one standing person".to_string()
+    } else {
+        format!("the body stands along {detected}: pass --up {detected} or leave --up out")
+    };
+    let axis = up.axis;
+    let height = bounds.size()[axis];
+    let width = (0..3).filter(|&a| a != axis).map(|a| bounds.size()[a]).fold(0.0, f64::max);
+    let mid = 0.5 * (bounds.min[axis] + bounds.max[axis]);
+    let problem = if (centroid[axis] < mid) != up.negative {
+        "the head is below the feet (the surface's centroid is below mid-height)".to_string()
+    } else if height < MIN_HEIGHT_TO_WIDTH * width {
+        format!(
+            "the body is {:.0}% as tall as it is wide, and a standing person is at least {:.0}%",
+            100.0 * height / width,
+            100.0 * MIN_HEIGHT_TO_WIDTH
+        )
+    } else {
+        return Ok(());
+    };
+    Err(FrameError::ImplausibleUp { up, problem, hint })
+}
+
+/// Finds the canonical frame of `mesh` (a cleaned body), honouring `options`; a given unit or
+/// up axis that makes no standing person is refused with the likely fix.
+pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, FrameError> {
+    let bounds =
+        mesh.bounds().unwrap_or(crate::body::mesh::Aabb { min: DVec3::ZERO, max: DVec3::ZERO });
+    let [all] = accumulate(mesh, |m: &mut [Moments; 1], p, a| m[0].add(p, a, DVec2::ZERO));
+    let centroid = all.mean().unwrap_or(bounds.min);
+    let axis = bounds.size().max_position();
+    let detected_up =
+        Direction { axis, negative: centroid[axis] < 0.5 * (bounds.min[axis] + bounds.max[axis]) };
+    let up = match options.up {
+        Some(up) => {
+            check_up(up, &bounds, centroid, detected_up)?;
+            up
+        }
+        None => detected_up,
+    };
+    let u = up.vector();
+    let (floor, top) =
+        (bounds.min.dot(u).min(bounds.max.dot(u)), bounds.min.dot(u).max(bounds.max.dot(u)));
+    let height = top - floor;
+    let units = match options.units {
+        Some(units) => {
+            let height_mm = height * units.mm();
+            if !(PERSON_HEIGHT_MM.0..=PERSON_HEIGHT_MM.1).contains(&height_mm) {
+                let hint = match Units::from_height(height) {
+                    Some(fit) => format!(
+                        "the file looks like {fit}: pass --units {fit} or leave --units out"
+                    ),
+                    None => {
+                        format!("no unit makes it a person along {up}: check --up and the file")
+                    }
+                };
+                return Err(FrameError::ImplausibleUnits { units, height_mm, hint });
+            }
+            units
+        }
+        None => Units::from_height(height).ok_or(FrameError::UnknownUnits { height, up })?,
+    };
+
+    // Horizontal coordinates on the two other axes; bands by fraction of the height:
+    // trunk (hips to shoulders), feet, shins.
+    let e1 = Direction { axis: (up.axis + 1) % 3, negative: false }.vector();
+    let e2 = Direction { axis: (up.axis + 2) % 3, negative: false }.vector();
+    let flat = |p: DVec3| DVec2::new(p.dot(e1), p.dot(e2));
+    let [trunk, feet, shins] = accumulate(mesh, |m: &mut [Moments; 3], p, a| {
+        let f = (p.dot(u) - floor) / height;
+        let band = match f {
+            _ if (0.45..=0.75).contains(&f) => 0,
+            _ if f <= 0.04 => 1,
+            _ if (0.10..=0.25).contains(&f) => 2,
+            _ => return,
+        };
+        m[band].add(p, a, flat(p));
+    });
+    let centre = trunk.mean().unwrap_or(bounds.min);
+    let c2 = flat(centre);
+    let w = trunk.weight.max(f64::MIN_POSITIVE);
+    let (sxx, sxy, syy) =
+        (trunk.xx / w - c2.x * c2.x, trunk.xy / w - c2.x * c2.y, trunk.yy / w - c2.y * c2.y);
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let front_back = DVec2::new(-theta.sin(), theta.cos());
+    let evidence = match (feet.mean(), shins.mean()) {
+        (Some(f), Some(s)) => (flat(f) - flat(s)).dot(front_back),
+        _ => 0.0,
+    };
+    let (facing, facing_detected) = match options.facing {
+        Some(f) => {
+            if f.axis == up.axis {
+                return Err(FrameError::FacingNotHorizontal { facing: f, up });
+            }
+            (f.vector(), false)
+        }
+        None => {
+            let forward = if evidence >= 0.0 { front_back } else { -front_back };
+            ((e1 * forward.x + e2 * forward.y).normalize(), true)
+        }
+    };
+    let left = u.cross(facing);
+    let rotation = DMat3::from_cols(left, -facing, u).transpose();
+    let scale = units.mm();
+    let c = rotation * (centre * scale);
+    let translation = DVec3::new(-c.x, -c.y, -floor * scale);
+    Ok(CanonicalFrame {
+        units,
+        units_detected: options.units.is_none(),
+        up,
+        up_detected: options.up.is_none(),
+        facing,
+        facing_detected,
+        facing_evidence_mm: evidence.abs() * scale,
+        height_mm: height * scale,
+        from_header: false,
+        rotation,
+        translation,
+    })
+}

@@ -1,0 +1,200 @@
+//! One closed loop of a cross-section and what a tailor measures on it.
+
+use crate::body::mesh::Aabb;
+use glam::DVec2;
+
+/// A closed polygon in a horizontal plane (the last point connects back to the first),
+/// counter-clockwise seen from above for the outside of a body.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Contour {
+    /// The loop's points (x, y).
+    pub points: Vec<DVec2>,
+}
+
+impl Contour {
+    /// The loop's edges as point pairs, including the closing edge.
+    pub(crate) fn edges(&self) -> impl Iterator<Item = (DVec2, DVec2)> + '_ {
+        let n = self.points.len();
+        (0..n).map(move |i| (self.points[i], self.points[(i + 1) % n]))
+    }
+
+    /// Length of the contour itself (follows every concavity).
+    pub fn perimeter(&self) -> f64 {
+        self.edges().map(|(a, b)| a.distance(b)).sum()
+    }
+
+    /// The loop's bounding box (in the plane z = 0), or `None` for a loop without points.
+    pub fn bounds(&self) -> Option<Aabb> {
+        Aabb::around(self.points.iter().map(|p| p.extend(0.0)))
+    }
+
+    /// The centre of the loop's bounding box (paper eq. 5 and eq. 9); the origin for a loop
+    /// without points.
+    pub fn bbox_centre(&self) -> DVec2 {
+        self.bounds().map_or(DVec2::ZERO, |b| (0.5 * (b.min + b.max)).truncate())
+    }
+
+    /// Tape girth: the perimeter of the convex hull, what a tape measure laid around reads.
+    ///
+    /// ```
+    /// use dressform::body::slice::Contour;
+    /// use glam::DVec2;
+    ///
+    /// // A 100 mm square with a notch 30 mm deep in one side: the tape bridges the notch.
+    /// let points = [(0., 0.), (100., 0.), (100., 100.), (60., 100.), (50., 70.), (40., 100.), (0., 100.)]
+    ///     .map(|(x, y)| DVec2::new(x, y))
+    ///     .to_vec();
+    /// let notched = Contour { points };
+    /// assert!((notched.tape_girth() - 400.0).abs() < 1e-9);
+    /// assert!(notched.perimeter() > 400.0); // the contour itself follows the notch
+    /// ```
+    pub fn tape_girth(&self) -> f64 {
+        let hull = convex_hull(&self.points);
+        Contour { points: hull }.perimeter()
+    }
+
+    /// Signed area (shoelace): positive when counter-clockwise.
+    pub fn signed_area(&self) -> f64 {
+        0.5 * self.edges().map(|(a, b)| a.perp_dot(b)).sum::<f64>()
+    }
+
+    /// Centroid of the enclosed region (falls back to the mean point for a zero-area loop).
+    pub fn centroid(&self) -> DVec2 {
+        let area = self.signed_area();
+        if area.abs() < f64::EPSILON {
+            let n = self.points.len().max(1) as f64;
+            return self.points.iter().copied().sum::<DVec2>() / n;
+        }
+        let sum: DVec2 = self.edges().map(|(a, b)| (a + b) * a.perp_dot(b)).sum();
+        sum / (6.0 * area)
+    }
+
+    /// The part of the loop between the vertical lines x = `lo` and x = `hi` (Sutherland-
+    /// Hodgman clipping; the cuts become straight edges along the lines).
+    pub fn clip_x(&self, lo: f64, hi: f64) -> Contour {
+        let keep_right = clip_half_plane(&self.points, |p| p.x - lo);
+        Contour { points: clip_half_plane(&keep_right, |p| hi - p.x) }
+    }
+
+    /// The part of the loop where `normal . p <= offset` (Sutherland-Hodgman clipping; the cut
+    /// becomes a straight edge along the line).
+    pub fn clip_half_plane(&self, normal: DVec2, offset: f64) -> Contour {
+        Contour { points: clip_half_plane(&self.points, |p| offset - normal.dot(p)) }
+    }
+
+    /// The part of the loop where `side(p) >= 0`, for a `side` linear along each edge (or
+    /// nearly so: crossings are interpolated linearly); the cuts become straight edges.
+    pub fn keep_where(&self, side: impl Fn(DVec2) -> f64) -> Contour {
+        Contour { points: clip_half_plane(&self.points, side) }
+    }
+
+    /// Whether `p` lies inside the loop (even-odd rule).
+    pub fn contains(&self, p: DVec2) -> bool {
+        let mut inside = false;
+        for (a, b) in self.edges() {
+            if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+                inside = !inside;
+            }
+        }
+        inside
+    }
+}
+
+/// The part of the closed polygon `points` where `side(p) >= 0` (`side` linear in `p`).
+fn clip_half_plane(points: &[DVec2], side: impl Fn(DVec2) -> f64) -> Vec<DVec2> {
+    let n = points.len();
+    let mut out = Vec::with_capacity(n + 2);
+    for i in 0..n {
+        let (a, b) = (points[i], points[(i + 1) % n]);
+        let (sa, sb) = (side(a), side(b));
+        if sa >= 0.0 {
+            out.push(a);
+        }
+        if (sa >= 0.0) != (sb >= 0.0) {
+            out.push(a + (b - a) * (sa / (sa - sb)));
+        }
+    }
+    out
+}
+
+/// Convex hull of `points`, counter-clockwise, without collinear points (Andrew's monotone
+/// chain). Written here because it is a dozen lines and the geometry crates that offer it
+/// would bring their own point types for this one function.
+pub fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
+    let mut p: Vec<DVec2> = points.to_vec();
+    p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    p.dedup();
+    if p.len() < 3 {
+        return p;
+    }
+    let turn = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    let mut hull: Vec<DVec2> = Vec::with_capacity(2 * p.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &DVec2>> =
+            if pass == 0 { Box::new(p.iter()) } else { Box::new(p.iter().rev()) };
+        for &q in iter {
+            while hull.len() >= start + 2
+                && turn(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(q);
+        }
+        hull.pop(); // the last point of each chain starts the other
+    }
+    hull
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn circle(r: f64, n: usize) -> Contour {
+        Contour {
+            points: (0..n)
+                .map(|i| {
+                    let a = 2.0 * PI * i as f64 / n as f64;
+                    DVec2::new(r * a.cos(), r * a.sin())
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn circle_measures() {
+        let c = circle(100.0, 3600);
+        assert!((c.perimeter() - 200.0 * PI).abs() < 0.01);
+        assert!((c.tape_girth() - c.perimeter()).abs() < 1e-9);
+        assert!((c.signed_area() - PI * 1e4).abs() < 1.0);
+        assert!(c.centroid().length() < 1e-9);
+        assert!(c.contains(DVec2::ZERO) && !c.contains(DVec2::new(101.0, 0.0)));
+    }
+
+    #[test]
+    fn tape_bridges_a_concavity() {
+        // A square with a notch: the tape reads the square's perimeter.
+        let pts = [(0., 0.), (10., 0.), (10., 10.), (6., 10.), (5., 2.), (4., 10.), (0., 10.)];
+        let c = Contour { points: pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect() };
+        assert!((c.tape_girth() - 40.0).abs() < 1e-12);
+        assert!(c.perimeter() > 40.0);
+    }
+
+    #[test]
+    fn clipping_a_circle_to_a_band() {
+        let c = circle(10.0, 3600).clip_x(-6.0, 6.0);
+        assert!(c.points.iter().all(|p| p.x >= -6.0 - 1e-9 && p.x <= 6.0 + 1e-9));
+        // Two arcs of half-angle acos(0.6) each side... the band keeps x in [-6, 6].
+        let arc = 2.0 * 10.0 * (2.0 * (0.6f64).asin());
+        let expected = arc + 2.0 * 16.0;
+        assert!((c.perimeter() - expected).abs() < 0.01, "{} vs {expected}", c.perimeter());
+    }
+
+    #[test]
+    fn hull_of_degenerate_input() {
+        assert_eq!(convex_hull(&[]).len(), 0);
+        let line = [DVec2::ZERO, DVec2::X, DVec2::new(2.0, 0.0)];
+        assert!(convex_hull(&line).len() <= 2);
+    }
+}

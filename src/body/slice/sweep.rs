@@ -1,0 +1,444 @@
+//! Cutting a mesh by many horizontal planes at once.
+//!
+//! Each triangle finds the planes it crosses by two binary searches in the sorted heights, so
+//! the work is proportional to the number of crossings, not triangles × planes. A triangle
+//! crossing plane `h` contributes one segment, from the point on its edge that runs down
+//! through `h` to the point on its edge that runs up; for an outward-oriented surface that
+//! makes outer loops counter-clockwise seen from above.
+
+use super::{Contour, Section};
+use crate::body::mesh::Mesh;
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
+
+/// One triangle's piece of one plane: from `start` on edge `from` to `end` on edge `to`.
+#[derive(Debug, Clone, Copy)]
+struct Segment {
+    from: u64,
+    to: u64,
+    start: DVec2,
+    end: DVec2,
+}
+
+/// Key of the undirected edge between vertices `a` and `b`.
+fn edge_key(a: u32, b: u32) -> u64 {
+    (u64::from(a.min(b)) << 32) | u64::from(a.max(b))
+}
+
+/// Where the edge between vertices `a` and `b` meets height `h`. Computed from the lower
+/// vertex index, so both triangles sharing the edge get the same point.
+fn crossing(mesh: &Mesh, a: u32, b: u32, h: f64) -> DVec2 {
+    let (i, j) = (a.min(b) as usize, a.max(b) as usize);
+    let (p, q): (DVec3, DVec3) = (mesh.positions[i], mesh.positions[j]);
+    let t = (h - p.z) / (q.z - p.z);
+    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    (p + (q - p) * t).truncate()
+}
+
+/// The segment triangle `tri` leaves on the plane at `h` (it must cross it).
+fn segment(mesh: &Mesh, tri: [u32; 3], h: f64) -> Segment {
+    let above = tri.map(|v| mesh.positions[v as usize].z >= h);
+    let (mut down, mut up) = ((0, 0), (0, 0));
+    for k in 0..3 {
+        let (a, b) = (tri[k], tri[(k + 1) % 3]);
+        match (above[k], above[(k + 1) % 3]) {
+            (true, false) => down = (a, b),
+            (false, true) => up = (a, b),
+            _ => {}
+        }
+    }
+    Segment {
+        from: edge_key(down.0, down.1),
+        to: edge_key(up.0, up.1),
+        start: crossing(mesh, down.0, down.1, h),
+        end: crossing(mesh, up.0, up.1, h),
+    }
+}
+
+/// Cross-sections of `mesh` at each of `heights` (any order; returned in the same order). A
+/// height that is not a finite number crosses nothing: its section is empty.
+///
+/// ```
+/// use dressform::body::mesh::Mesh;
+/// use dressform::body::slice::sections;
+/// use glam::DVec3;
+///
+/// // A closed cube, 100 mm on a side, standing on the floor.
+/// let corners = (0..8)
+///     .map(|i| DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64) * 100.0)
+///     .collect();
+/// let faces = [[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
+///              [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]];
+/// let cube = Mesh::new(corners, faces.to_vec());
+///
+/// let cut = sections(&cube, &[50.0, 150.0]);
+/// assert_eq!(cut[0].loops.len(), 1); // one loop around the cube at 50 mm
+/// assert!((cut[0].loops[0].perimeter() - 400.0).abs() < 1e-9);
+/// assert!(cut[1].loops.is_empty()); // nothing above the cube
+/// ```
+pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
+    let mut order: Vec<usize> = (0..heights.len()).filter(|&i| heights[i].is_finite()).collect();
+    order.sort_by(|&a, &b| heights[a].total_cmp(&heights[b]));
+    let planes = Planes::new(order.iter().map(|&i| heights[i]).collect());
+
+    // A triangle crosses planes zmin < h <= zmax (a vertex on a plane counts as above it):
+    // those from the fewest to the most planes at or below one of its vertices. So each
+    // vertex is looked up once, and most triangles are dropped after comparing three counts.
+    let below: Vec<u32> =
+        mesh.positions.par_iter().map(|p| planes.at_or_below(p.z) as u32).collect();
+    let crossed: Vec<(u32, u32, u32)> = mesh
+        .triangles
+        .par_iter()
+        .enumerate()
+        .filter_map(|(t, tri)| {
+            let c = tri.map(|v| below[v as usize]);
+            let (first, end) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+            (first < end).then_some((first, end, t as u32))
+        })
+        .collect();
+    // The triangles of each plane, grouped by a counting sort.
+    let n = planes.sorted.len();
+    let mut offsets = vec![0usize; n + 1];
+    for &(first, end, _) in &crossed {
+        for k in first..end {
+            offsets[k as usize + 1] += 1;
+        }
+    }
+    for k in 0..n {
+        offsets[k + 1] += offsets[k];
+    }
+    let mut fill = offsets.clone();
+    let mut crossing = vec![0u32; offsets[n]];
+    for &(first, end, t) in &crossed {
+        for k in first as usize..end as usize {
+            crossing[fill[k]] = t;
+            fill[k] += 1;
+        }
+    }
+
+    let by_plane: Vec<Section> = (0..n)
+        .into_par_iter()
+        .map(|k| {
+            let h = planes.sorted[k];
+            let segments: Vec<Segment> = crossing[offsets[k]..offsets[k + 1]]
+                .iter()
+                .map(|&t| segment(mesh, mesh.triangles[t as usize], h))
+                .collect();
+            chain(&segments, h)
+        })
+        .collect();
+    let mut out: Vec<Section> = heights
+        .iter()
+        .map(|&height| Section { height, loops: Vec::new(), bridged_gaps: 0 })
+        .collect();
+    for (section, &i) in by_plane.into_iter().zip(&order) {
+        out[i] = section;
+    }
+    out
+}
+
+/// Sorted, finite plane heights, bucketed so that counting the planes at or below a height
+/// takes a table lookup and a search among one or two buckets' planes instead of all of them.
+struct Planes {
+    sorted: Vec<f64>,
+    lowest: f64,
+    /// Buckets per unit of height; 0 when the planes span no range a bucket can divide (one
+    /// plane, all at one height, or a span too wide or too narrow for f64), and then the
+    /// search runs over all planes.
+    scale: f64,
+    /// `first[b]`: the planes at or below the lower edge of bucket `b`.
+    first: Vec<usize>,
+}
+
+impl Planes {
+    fn new(sorted: Vec<f64>) -> Planes {
+        let (lowest, highest) = match (sorted.first(), sorted.last()) {
+            (Some(&lo), Some(&hi)) => (lo, hi),
+            _ => (0.0, 0.0),
+        };
+        let buckets = 4 * sorted.len().min(1 << 14);
+        let scale = buckets as f64 / (highest - lowest);
+        let scale = if highest > lowest && scale.is_finite() { scale } else { 0.0 };
+        let first = (0..=buckets)
+            .map(|b| sorted.partition_point(|&h| (h - lowest) * scale <= b as f64))
+            .collect();
+        Planes { sorted, lowest, scale, first }
+    }
+
+    /// How many planes lie at or below `z` (none below a NaN).
+    fn at_or_below(&self, z: f64) -> usize {
+        let n = self.sorted.len();
+        if n == 0 || z.is_nan() || z < self.lowest {
+            return 0;
+        }
+        if z >= self.sorted[n - 1] {
+            return n;
+        }
+        if self.scale == 0.0 {
+            return self.sorted.partition_point(|&h| h <= z);
+        }
+        // The bucket of `z`, widened by one on each side against rounding.
+        let b = ((z - self.lowest) * self.scale) as usize;
+        let buckets = self.first.len() - 1;
+        let (from, to) = (
+            self.first[b.saturating_sub(1).min(buckets)],
+            self.first[b.saturating_add(2).min(buckets)],
+        );
+        from + self.sorted[from..to].partition_point(|&h| h <= z)
+    }
+}
+
+/// No segment.
+const NONE: u32 = u32::MAX;
+
+/// For each segment, the one that starts on the edge where it ends (`NONE` if there is
+/// none); when several start on one edge (a non-manifold edge), the first of them.
+fn successors(segments: &[Segment]) -> Vec<u32> {
+    let mut starting: FxHashMap<u64, u32> =
+        FxHashMap::with_capacity_and_hasher(segments.len(), Default::default());
+    for (i, s) in segments.iter().enumerate().rev() {
+        starting.insert(s.from, i as u32);
+    }
+    segments.iter().map(|s| starting.get(&s.to).copied().unwrap_or(NONE)).collect()
+}
+
+/// Chains one plane's segments into loops, closing open chains by pairing their loose ends.
+fn chain(segments: &[Segment], height: f64) -> Section {
+    let next = successors(segments);
+    let mut is_target = vec![false; segments.len()];
+    for &j in &next {
+        if j != NONE {
+            is_target[j as usize] = true;
+        }
+    }
+    let mut used = vec![false; segments.len()];
+    let walk = |first: usize, used: &mut Vec<bool>| -> (Vec<DVec2>, bool) {
+        let mut points = Vec::new();
+        let mut at = first;
+        loop {
+            used[at] = true;
+            points.push(segments[at].start);
+            match next[at] {
+                j if j as usize == first => return (points, true),
+                j if j != NONE && !used[j as usize] => at = j as usize,
+                _ => {
+                    points.push(segments[at].end); // an open chain keeps its last point
+                    return (points, false);
+                }
+            }
+        }
+    };
+    let mut closed = Vec::new();
+    let mut open = Vec::new();
+    // Open chains first, from their heads, so that no chain is entered in the middle.
+    for first in (0..segments.len()).filter(|&i| !is_target[i]) {
+        if !used[first] {
+            open.push(walk(first, &mut used).0);
+        }
+    }
+    for first in 0..segments.len() {
+        if !used[first] {
+            let (points, is_closed) = walk(first, &mut used);
+            if is_closed { closed.push(points) } else { open.push(points) }
+        }
+    }
+    let bridged_gaps = open.len();
+    closed.extend(close_open_chains(open));
+    let mut loops: Vec<(f64, Contour)> = closed
+        .into_iter()
+        .filter(|p| p.len() >= 3)
+        .map(|points| {
+            let c = Contour { points };
+            (c.signed_area().abs(), c)
+        })
+        .collect();
+    loops.sort_by(|a, b| b.0.total_cmp(&a.0));
+    Section { height, loops: loops.into_iter().map(|(_, c)| c).collect(), bridged_gaps }
+}
+
+/// How many of the nearest chain starts each open chain's end may be bridged to (besides its
+/// own start): a plane crosses a few holes, so a handful is plenty.
+const BRIDGE_CANDIDATES: usize = 8;
+
+/// Joins open chains into loops by the shortest bridges first: of all (chain end, chain
+/// start) pairs, its own start included, the closest pair is joined, then the closest of the
+/// rest, and so on; each join bridges one gap of the scan with a straight edge, and the joins
+/// close into loops. Taking the pairs in order of length makes the result independent of the
+/// order the chains were found in, so that nearby planes through the same hole close the same
+/// way (an arm and the torso seen through an armpit hole are joined at every level where the
+/// gap between them is shorter than the hole, never at one level and not at the next).
+fn close_open_chains(open: Vec<Vec<DVec2>>) -> Vec<Vec<DVec2>> {
+    let n = open.len();
+    // Each end's nearest starts (its own always among them): memory stays linear in the
+    // number of chains on a mesh shredded into many (a fuzzed or broken file).
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(n * (BRIDGE_CANDIDATES + 1));
+    let mut near: Vec<(f64, usize)> = Vec::with_capacity(n);
+    for (i, chain) in open.iter().enumerate() {
+        let end = chain[chain.len() - 1];
+        near.clear();
+        near.extend(open.iter().enumerate().map(|(j, c)| (end.distance_squared(c[0]), j)));
+        if near.len() > BRIDGE_CANDIDATES {
+            near.select_nth_unstable_by(BRIDGE_CANDIDATES, |a, b| a.0.total_cmp(&b.0));
+            near.truncate(BRIDGE_CANDIDATES);
+        }
+        if !near.iter().any(|&(_, j)| j == i) {
+            near.push((end.distance_squared(chain[0]), i));
+        }
+        pairs.extend(near.iter().map(|&(d, j)| (d, i, j)));
+    }
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+    let (mut next, mut entered) = (vec![usize::MAX; n], vec![false; n]);
+    for (_, i, j) in pairs {
+        if next[i] == usize::MAX && !entered[j] {
+            next[i] = j;
+            entered[j] = true;
+        }
+    }
+    // Ends whose candidates were all taken: the starts left over, in order.
+    let mut free = (0..n).filter(|&j| !entered[j]);
+    for at in next.iter_mut().filter(|at| **at == usize::MAX) {
+        *at = free.next().expect("as many starts left as ends");
+    }
+    let mut taken = vec![false; n];
+    let mut loops = Vec::new();
+    for first in 0..n {
+        let mut points = Vec::new();
+        let mut at = first;
+        while !taken[at] {
+            taken[at] = true;
+            points.extend_from_slice(&open[at]);
+            at = next[at];
+        }
+        if !points.is_empty() {
+            loops.push(points);
+        }
+    }
+    loops
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    /// A closed vertical prism over an n-gon of radius r, from z = 0 to z = 10, outward.
+    fn prism(n: usize, r: f64) -> Mesh {
+        let mut p = Vec::new();
+        for z in [0.0, 10.0] {
+            for i in 0..n {
+                let a = 2.0 * PI * i as f64 / n as f64;
+                p.push(DVec3::new(r * a.cos(), r * a.sin(), z));
+            }
+        }
+        p.push(DVec3::new(0.0, 0.0, 0.0));
+        p.push(DVec3::new(0.0, 0.0, 10.0));
+        let n32 = n as u32;
+        let mut t = Vec::new();
+        for i in 0..n32 {
+            let j = (i + 1) % n32;
+            t.push([i, j, n32 + j]);
+            t.push([i, n32 + j, n32 + i]);
+            t.push([2 * n32, j, i]);
+            t.push([2 * n32 + 1, n32 + i, n32 + j]);
+        }
+        Mesh::new(p, t)
+    }
+
+    #[test]
+    fn prism_sections_are_ccw_polygons() {
+        let mesh = prism(64, 50.0);
+        assert!(mesh.signed_volume() > 0.0);
+        let s = sections(&mesh, &[5.0, 2.5, 7.5]);
+        assert_eq!(s.len(), 3);
+        assert_eq!(s[1].height, 2.5);
+        for sec in &s {
+            assert_eq!(sec.loops.len(), 1);
+            assert_eq!(sec.bridged_gaps, 0);
+            let c = &sec.loops[0];
+            assert_eq!(c.points.len(), 128, "a point on every side and every quad diagonal");
+            assert!(c.signed_area() > 0.0, "counter-clockwise from above");
+            let expected = 64.0 * 2.0 * 50.0 * (PI / 64.0).sin();
+            assert!((c.perimeter() - expected).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn planes_through_vertices_still_give_closed_loops() {
+        let mesh = prism(16, 10.0);
+        for h in [0.0, 10.0] {
+            let s = &sections(&mesh, &[h])[0];
+            assert!(s.loops.iter().all(|l| l.points.len() >= 3));
+            assert_eq!(s.bridged_gaps, 0);
+        }
+    }
+
+    #[test]
+    fn heights_that_are_no_numbers_or_far_apart_leave_the_others_exact() {
+        let mesh = prism(64, 50.0);
+        let heights = [2.5, f64::NAN, 7.5, f64::INFINITY, f64::NEG_INFINITY, 1e308, -1e308, 5.0];
+        let s = sections(&mesh, &heights);
+        assert_eq!(s.len(), heights.len());
+        for (k, sec) in s.iter().enumerate() {
+            let inside = (0.0..=10.0).contains(&heights[k]);
+            assert_eq!(sec.loops.len(), usize::from(inside), "height {}", heights[k]);
+            if inside {
+                assert_eq!(sec.loops[0].points.len(), 128, "height {}", heights[k]);
+            }
+        }
+        // A span too narrow to divide into buckets (subnormal numbers).
+        let s = sections(&mesh, &[5e-310, 6e-310, 7e-310]);
+        assert!(s.iter().all(|sec| sec.loops.len() == 1 && sec.loops[0].points.len() == 128));
+    }
+
+    #[test]
+    fn planes_outside_give_empty_sections() {
+        let s = sections(&prism(8, 1.0), &[-1.0, 11.0]);
+        assert!(s.iter().all(|s| s.loops.is_empty()));
+    }
+
+    #[test]
+    fn holes_are_bridged_and_reported() {
+        let mut mesh = prism(32, 20.0);
+        // Remove two side quads: a hole crossing the plane at z = 5.
+        mesh.triangles.drain(0..8);
+        let s = &sections(&mesh, &[5.0])[0];
+        assert_eq!(s.loops.len(), 1);
+        assert_eq!(s.bridged_gaps, 1);
+        // The gap is bridged by a chord across the two missing sides.
+        let side = 2.0 * 20.0 * (PI / 32.0).sin();
+        let chord = 2.0 * 20.0 * (2.0 * PI / 32.0).sin();
+        assert!((s.loops[0].perimeter() - (30.0 * side + chord)).abs() < 1e-9);
+    }
+
+    /// `prism(32, 20)` without the sides (and their cap wedges) `sides`, moved by `dx`.
+    fn holed_prism(sides: &[usize], dx: f64) -> Mesh {
+        let mesh = prism(32, 20.0);
+        let kept = mesh.triangles.iter().enumerate().filter(|(t, _)| !sides.contains(&(t / 4)));
+        let moved = mesh.positions.iter().map(|p| *p + DVec3::X * dx).collect();
+        Mesh::new(moved, kept.map(|(_, t)| *t).collect())
+    }
+
+    #[test]
+    fn chains_close_alike_whatever_order_they_are_found_in() {
+        // `b` is nearly closed (a 1 mm gap); `a`'s end is 5 mm from `b`'s start and 6 mm from
+        // its own. Joining `a` to `b` first would bridge 5 mm and then 7 mm instead of 1 and 6.
+        let pts = |p: &[(f64, f64)]| p.iter().map(|&(x, y)| DVec2::new(x, y)).collect::<Vec<_>>();
+        let a = pts(&[(0.0, 6.0), (-10.0, 6.0), (-10.0, -10.0), (0.0, -10.0), (0.0, 0.0)]);
+        let b = pts(&[(5.0, 0.0), (15.0, 0.0), (15.0, 10.0), (5.0, 10.0), (5.0, 1.0)]);
+        for open in [vec![a.clone(), b.clone()], vec![b, a]] {
+            let mut lengths: Vec<usize> = close_open_chains(open).iter().map(Vec::len).collect();
+            lengths.sort();
+            assert_eq!(lengths, [5, 5]);
+        }
+    }
+
+    #[test]
+    fn a_loop_cut_by_two_holes_is_joined_back_into_one() {
+        let mesh = holed_prism(&[0, 1, 16, 17], 0.0);
+        let s = &sections(&mesh, &[5.0])[0];
+        assert_eq!(s.loops.len(), 1);
+        assert_eq!(s.bridged_gaps, 2);
+        assert!((s.loops[0].signed_area().abs() - PI * 400.0).abs() < 0.15 * PI * 400.0);
+    }
+}

@@ -1,0 +1,9 @@
+//! One call per command and what it leaves behind: the pipeline, the reconstruction with pose
+//! symmetry, the output set, the pictures, and the scan report of
+//! `dressform info`.
+
+pub mod info;
+pub mod outputs;
+pub mod pipeline;
+pub mod preview;
+pub mod reconstruct;

@@ -1,0 +1,107 @@
+//! What the commands write: a pipeline result as its set of files, by name and content.
+//! [`crate::atomic_output`] commits such a set into a directory, all or nothing.
+//!
+//! | file | what |
+//! |---|---|
+//! | `mannequin.<ext>` | the mannequin, as the [`Export`] says (format, units, axes, frame) |
+//! | [`PROFILES`] | its sections ([`crate::shape::profiles`]), what a form is fitted to |
+//! | [`MEASUREMENTS`] | Table 1 and Fig. 11 ([`crate::shape::measure::Comparison`]); after pose symmetry, with the scan's column ([`crate::run::reconstruct::MeasurementsReport`]) |
+//! | [`SETPOINTS`] | with a form: the set-points ([`crate::form::setpoints`]) |
+//! | [`PREVIEW`] | the scan (and the pose-symmetric scan) and the mannequin in three views |
+//! | [`SECTIONS`] | the chest, waist and hip sections of both (paper Fig. 9 and 11) |
+//! | `posed.<ext>` | after pose symmetry: the pose-symmetric scan, as the [`Export`] says |
+//! | [`RIGGED`] | after pose symmetry: the scan with the fitted skeleton and its skin weights |
+//! | [`FIT`] | after pose symmetry: the fit ([`crate::run::reconstruct::FitReport`]) |
+
+use crate::atomic_output::OutputSet;
+use crate::body::scan::Scan;
+use crate::body::scan::format::Export;
+use crate::form::setpoints::SetPoints;
+use crate::run::pipeline::Symmetrized;
+use crate::run::preview::{preview_png, sections_svg};
+use crate::run::reconstruct::Reposed;
+
+/// The mannequin's file name without its extension (the export adds it).
+pub const MANNEQUIN: &str = "mannequin";
+/// The mannequin's profiles.
+pub const PROFILES: &str = "profiles.json";
+/// The measurements of the scan and the mannequin.
+pub const MEASUREMENTS: &str = "measurements.json";
+/// The form's set-points.
+pub const SETPOINTS: &str = "setpoints.json";
+/// The picture of the scan and the mannequin.
+pub const PREVIEW: &str = "preview.png";
+/// The picture of the sections.
+pub const SECTIONS: &str = "sections.svg";
+/// The pose-symmetric scan's file name without its extension (the export adds it).
+pub const POSED: &str = "posed";
+/// The scan with the fitted model's skeleton and skin weights (glTF, whatever the export).
+pub const RIGGED: &str = "rigged.glb";
+/// What the fit found and the symmetric pose.
+pub const FIT: &str = "fit.json";
+
+/// The files of a mannequin made from a scan (`symmetrize`), after pose symmetry
+/// (`reconstruct`), with the form's set-points when a form was fitted to it (`run`, `demo`).
+#[derive(Debug, Clone, Copy)]
+pub struct Outputs<'a> {
+    result: &'a Symmetrized,
+    /// The body the mannequin was made from.
+    scan: &'a Scan,
+    export: &'a Export,
+    setpoints: Option<&'a SetPoints>,
+    /// The input scan and how it was re-posed, after pose symmetry.
+    reposed: Option<(&'a Scan, &'a Reposed)>,
+}
+
+impl<'a> Outputs<'a> {
+    /// The files of `result`, the mannequin of `scan`, its own file written as `export` says.
+    pub fn of(result: &'a Symmetrized, scan: &'a Scan, export: &'a Export) -> Self {
+        Outputs { result, scan, export, setpoints: None, reposed: None }
+    }
+
+    /// The files of `result`, the mannequin of the pose-symmetric scan of `reposed`, made from
+    /// the scan `input` (canonical frame, as fitted); the mannequin and the pose-symmetric scan
+    /// written as `export` says.
+    pub fn reposed(
+        result: &'a Symmetrized,
+        reposed: &'a Reposed,
+        input: &'a Scan,
+        export: &'a Export,
+    ) -> Self {
+        Outputs { reposed: Some((input, reposed)), ..Self::of(result, &reposed.posed, export) }
+    }
+
+    /// With the set-points of a form fitted to the mannequin.
+    pub fn with_setpoints(self, setpoints: &'a SetPoints) -> Self {
+        Outputs { setpoints: Some(setpoints), ..self }
+    }
+
+    /// The set of files (see the module documentation).
+    pub fn files(&self) -> Result<OutputSet, serde_json::Error> {
+        let (result, scan) = (self.result, self.scan);
+        let mut set = OutputSet::new();
+        set.add(self.export.file_name(MANNEQUIN), result.mannequin_file(self.export, &scan.frame));
+        set.add(PROFILES, serde_json::to_vec_pretty(&result.profiles)?);
+        if let Some(setpoints) = self.setpoints {
+            set.add(SETPOINTS, setpoints.to_json_string());
+        }
+        set.add(SECTIONS, sections_svg(&scan.body, result));
+        match self.reposed {
+            None => {
+                set.add(MEASUREMENTS, serde_json::to_vec_pretty(&result.comparison)?);
+                set.add(PREVIEW, preview_png(&[(&scan.body, "scan")], result));
+            }
+            Some((input, reposed)) => {
+                let measurements = reposed.measurements(&result.comparison);
+                set.add(MEASUREMENTS, serde_json::to_vec_pretty(&measurements)?);
+                let bodies = [(&input.body, "scan"), (&scan.body, "pose-symmetric")];
+                set.add(PREVIEW, preview_png(&bodies, result));
+                let (posed, _) = self.export.place(&scan.body, &scan.frame);
+                set.add(self.export.file_name(POSED), self.export.encode(&posed));
+                set.add(RIGGED, reposed.rigged_glb(input));
+                set.add(FIT, serde_json::to_vec_pretty(&reposed.fit_report())?);
+            }
+        }
+        Ok(set)
+    }
+}

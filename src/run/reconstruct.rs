@@ -1,0 +1,330 @@
+//! Scan to mannequin with pose symmetry first (the paper's whole of section 3): fit the body
+//! model to the scan (eq. 4), give the scan the model's rig, re-pose it symmetric (eq. 3)
+//! ([`repose`]), then the shape symmetry of that: the mannequin alone ([`reconstruct`], for
+//! `reconstruct`) or the mannequin with the form fitted to it ([`reconstruct_shape`], for `run`
+//! and `demo`).
+
+use crate::body::regions::BodyRegions;
+use crate::body::scan::Scan;
+use crate::body::segmented_body::SegmentedBody;
+use crate::pose::body_model::BodyModel;
+use crate::pose::model_fit::verdict::{self, NotConverged, RegionResidual};
+use crate::pose::model_fit::{self, FitOptions, ModelFit, ModelFitError};
+use crate::pose::pose_symmetry::{self, PoseOverrides};
+use crate::pose::rig_transfer::{self, RigTransfer};
+use crate::run::pipeline::{self, ShapeError, Shaped, Symmetrized};
+use crate::shape::mannequin::{MannequinError, MannequinOptions};
+use crate::shape::measure::{Comparison, Girth, Measurements, levels, measure_at};
+use form_description::FormDescription;
+use glam::DVec3;
+use serde::Serialize;
+
+/// How to reconstruct.
+#[derive(Debug, Clone, Default)]
+pub struct ReconstructOptions {
+    /// How to fit the model.
+    pub fit: FitOptions,
+    /// Joint angles set on the symmetric pose.
+    pub pose: PoseOverrides,
+    /// How to build the mannequin.
+    pub mannequin: MannequinOptions,
+}
+
+/// The steps of [`repose`], reported to `progress` as they start; [`reconstruct`] goes on with
+/// [`pipeline::STEPS`], [`reconstruct_shape`] with [`pipeline::SHAPE_STEPS`].
+pub const STEPS: [&str; 3] =
+    ["fitting the body model", "transferring the rig", "re-posing the scan symmetric"];
+
+/// A scan re-posed symmetric: what [`repose`] made.
+#[derive(Debug, Clone)]
+pub struct Reposed {
+    /// The model as fitted: the one given with its limb segments' lengths as more shape
+    /// directions ([`model_fit::segment_lengths`]); `fit`'s beta is its.
+    pub model: BodyModel,
+    /// The fitted model.
+    pub fit: ModelFit,
+    /// The symmetric pose (one rotation vector per bone).
+    pub symmetric: Vec<DVec3>,
+    /// The fit's residual per body region.
+    pub residuals: Vec<RegionResidual>,
+    /// The scan's skin weights.
+    pub rig: RigTransfer,
+    /// The pose-symmetric scan (same vertices and triangles as the input, moved).
+    pub posed: Scan,
+    /// The input scan's segmentation, where it can be segmented as it stands.
+    pub scan_regions: Option<BodyRegions>,
+    /// The input scan's own measurements, where it can be segmented as it stands.
+    pub scan_measurements: Option<Measurements>,
+    /// The fit's wall time (s).
+    pub fit_seconds: f64,
+}
+
+/// What [`reconstruct`] made: the re-posed scan and its mannequin.
+#[derive(Debug, Clone)]
+pub struct Reconstruction {
+    /// The fit and the pose-symmetric scan.
+    pub reposed: Reposed,
+    /// The pose-symmetric scan's mannequin and measurements.
+    pub result: Symmetrized,
+}
+
+/// What [`reconstruct_shape`] made: the re-posed scan, its mannequin and the form fitted to
+/// it.
+#[derive(Debug, Clone)]
+pub struct Reshaped {
+    /// The fit and the pose-symmetric scan.
+    pub reposed: Reposed,
+    /// The mannequin of the pose-symmetric scan, the form's fit and set-points, and the
+    /// pose-symmetric scan's and the mannequin's girths at every ring.
+    pub shaped: Shaped,
+    /// The input scan's tape girth at every ring (form order; `None` where it has no section
+    /// there or cannot be segmented as it stands), at the height the ring shapes on the
+    /// pose-symmetric scan.
+    pub scan_rings: Vec<Option<f64>>,
+}
+
+/// Why a reconstruction failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ReconstructError {
+    /// The fit could not run.
+    #[error(transparent)]
+    Fit(#[from] ModelFitError),
+    /// The fit ran but does not match the scan.
+    #[error(transparent)]
+    NotConverged(#[from] NotConverged),
+    /// The pose-symmetric scan gave no mannequin.
+    #[error("the pose-symmetric scan: {0}")]
+    Mannequin(#[from] MannequinError),
+    /// The form could not be fitted to the mannequin.
+    #[error("the pose-symmetric scan: {0}")]
+    Shape(#[from] ShapeError),
+}
+
+/// Fits `model` to `scan` (canonical frame), gives the scan the model's rig and re-poses it
+/// symmetric, calling `progress(step)` before each of [`STEPS`]. A fit that does not match
+/// the scan is an error ([`NotConverged`]), never a re-posed body.
+pub fn repose(
+    scan: &Scan,
+    model: &BodyModel,
+    options: &ReconstructOptions,
+    mut progress: impl FnMut(usize),
+) -> Result<Reposed, ReconstructError> {
+    progress(0);
+    let extended = model_fit::segment_lengths::extended(model);
+    let model = &extended;
+    let body = &scan.body;
+    let start = std::time::Instant::now();
+    let fitted = model_fit::fit(model, &model_fit::ScanPoints::of_mesh(body), &options.fit)?;
+    let fit_seconds = start.elapsed().as_secs_f64();
+    let residuals = verdict::residuals(model, &fitted, &body.positions);
+    verdict::verdict(&residuals)?;
+
+    progress(1);
+    let fitted_mesh = model.mesh(fitted.vertices(model));
+    let bones = model.skeleton.names.len();
+    let rig = rig_transfer::transfer(body, &fitted_mesh, &model.weights, bones);
+
+    progress(2);
+    let mut symmetric = pose_symmetry::symmetric(&fitted.theta, &model.skeleton);
+    options.pose.apply(&mut symmetric, &model.skeleton);
+    let moved = pose_symmetry::repose(
+        &body.positions,
+        &rig.weights,
+        &model.skeleton.parents,
+        &model.joints(&fitted.beta),
+        &fitted.theta,
+        &symmetric,
+        fitted.translation,
+    );
+    let mut posed = scan.clone();
+    posed.body.positions = moved;
+    // The symmetric legs stand a little higher or lower: the body moved so that its feet stand
+    // where the scan's did, the move recorded in the frame (so `--scan-frame` writes it back
+    // where the scan stood).
+    let drop = feet_drop(model, &fitted, &symmetric);
+    posed.frame.translate(&mut posed.body, DVec3::Z * drop);
+    posed.frame.centre_on_torso(&mut posed.body);
+
+    let scan_body = SegmentedBody::find(body).ok();
+    let scan_measurements = scan_body.as_ref().map(|body| measure_at(body, &levels(body)));
+    let scan_regions = scan_body.map(SegmentedBody::into_regions);
+    Ok(Reposed {
+        model: extended,
+        fit: fitted,
+        symmetric,
+        residuals,
+        rig,
+        posed,
+        scan_regions,
+        scan_measurements,
+        fit_seconds,
+    })
+}
+
+/// Reconstructs the mannequin of `scan` (canonical frame) with `model`, calling
+/// `progress(step)` before each step (indices into [`STEPS`] then [`pipeline::STEPS`]).
+pub fn reconstruct(
+    scan: &Scan,
+    model: &BodyModel,
+    options: &ReconstructOptions,
+    mut progress: impl FnMut(usize),
+) -> Result<Reconstruction, ReconstructError> {
+    let reposed = repose(scan, model, options, &mut progress)?;
+    let result =
+        pipeline::symmetrize(&reposed.posed, &options.mannequin, |s| progress(STEPS.len() + s))?;
+    Ok(Reconstruction { reposed, result })
+}
+
+/// The whole chain of `run` and `demo`: [`repose`], then the mannequin of the pose-symmetric
+/// scan with `form` fitted to it ([`pipeline::shape`]), and the input scan's girths at the
+/// rings beside the pose-symmetric scan's; `progress(step)` before each step (indices into
+/// [`STEPS`] then [`pipeline::SHAPE_STEPS`]).
+pub fn reconstruct_shape(
+    scan: &Scan,
+    model: &BodyModel,
+    options: &ReconstructOptions,
+    form: &FormDescription,
+    mut progress: impl FnMut(usize),
+) -> Result<Reshaped, ReconstructError> {
+    let reposed = repose(scan, model, options, &mut progress)?;
+    let shaped =
+        pipeline::shape(&reposed.posed, &options.mannequin, form, |s| progress(STEPS.len() + s))?;
+    // The pose-symmetric scan's frame is the input's moved by the feet's drop (and centred):
+    // a ring's height on the input is its height there less that move.
+    let dz =
+        reposed.posed.frame.file_frame().translation[2] - scan.frame.file_frame().translation[2];
+    let heights: Vec<f64> = shaped.rings.iter().map(|r| r.body_z_mm - dz).collect();
+    let scan_rings = match &reposed.scan_regions {
+        Some(regions) => {
+            let body = SegmentedBody::with_regions(&scan.body, regions);
+            pipeline::girths_at_rings(&body, form, &heights)
+        }
+        None => vec![None; heights.len()],
+    };
+    Ok(Reshaped { reposed, shaped, scan_rings })
+}
+
+/// How far re-posing from `fitted.theta` to `symmetric` lowers the feet (mm; negative when it
+/// raises them): measured on the fitted model, whose soles are whole, not on the scan, whose
+/// soles a scanner cuts at the floor plane (a foot lifted sideways keeps more of its sole, so
+/// the scan's lowest point after re-posing is not a sole's).
+fn feet_drop(model: &BodyModel, fitted: &ModelFit, symmetric: &[DVec3]) -> f64 {
+    let lowest = |theta: &[DVec3]| {
+        let body = model.posed(&fitted.beta, theta, fitted.translation);
+        body.iter().map(|p| p.z).fold(f64::INFINITY, f64::min)
+    };
+    lowest(&fitted.theta) - lowest(symmetric)
+}
+
+/// `measurements.json`: the paper's Table 1 with three columns (the scan as it stood, the
+/// pose-symmetric scan, the mannequin), and the pose-symmetric scan's full comparison.
+#[derive(Debug, Clone, Serialize)]
+pub struct MeasurementsReport<'a> {
+    /// Chest, waist and hip.
+    pub table: Vec<ThreeColumns>,
+    /// The input scan's measurements (`null` when it cannot be segmented as it stands).
+    pub scan: Option<&'a Measurements>,
+    /// Table 1 and Fig. 11 of the pose-symmetric scan and its mannequin.
+    pub pose_symmetric: &'a Comparison,
+}
+
+/// One row of the three-column Table 1.
+#[derive(Debug, Clone, Serialize)]
+pub struct ThreeColumns {
+    /// "chest", "waist" or "hip".
+    pub measure: &'static str,
+    /// The scan as it stood (at its own level), if it could be measured.
+    pub scan: Option<Girth>,
+    /// The pose-symmetric scan.
+    pub pose_symmetric: Girth,
+    /// The mannequin, at the pose-symmetric scan's level.
+    pub mannequin: Girth,
+}
+
+/// `fit.json`: what the fit found and what the symmetric pose is. Not the fit's wall time: the
+/// same scan gives the same bytes (the commands print the time).
+#[derive(Debug, Clone, Serialize)]
+pub struct FitReport {
+    /// Per bone: fitted and symmetric rotation vectors (degrees; see `README.md`, pose).
+    pub joints: Vec<JointAngles>,
+    /// The shape coefficients (standard deviations), the last ones the limb segments' lengths
+    /// ([`model_fit::segment_lengths`]).
+    pub beta: Vec<f64>,
+    /// The global translation (mm, canonical frame).
+    pub translation_mm: [f64; 3],
+    /// Root mean square distances of the last iteration's pairs.
+    pub residuals: model_fit::Residuals,
+    /// Per body region, the distance of the model to the scan, and the verdict's limit.
+    pub regions: Vec<RegionResidual>,
+    /// LM iterations.
+    pub iterations: usize,
+    /// Scan vertices whose skin weights were filled from their neighbours.
+    pub rig_filled_vertices: usize,
+}
+
+/// One bone's angles in `fit.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct JointAngles {
+    /// The bone's name.
+    pub name: String,
+    /// The fitted rotation vector (degrees).
+    pub fitted_deg: [f64; 3],
+    /// The symmetric pose's (degrees).
+    pub symmetric_deg: [f64; 3],
+}
+
+impl Reposed {
+    /// `measurements.json` of the pose-symmetric scan's `comparison` with its mannequin.
+    pub fn measurements<'a>(&'a self, c: &'a Comparison) -> MeasurementsReport<'a> {
+        let scan = self.scan_measurements.as_ref();
+        let table = c
+            .table
+            .iter()
+            .map(|row| ThreeColumns {
+                measure: row.measure,
+                scan: scan.map(|m| match row.measure {
+                    "chest" => m.chest,
+                    "waist" => m.waist,
+                    _ => m.hip,
+                }),
+                pose_symmetric: row.input,
+                mannequin: row.mannequin,
+            })
+            .collect();
+        MeasurementsReport { table, scan, pose_symmetric: c }
+    }
+
+    /// `fit.json`.
+    pub fn fit_report(&self) -> FitReport {
+        let model = &self.model;
+        let deg = |v: DVec3| (v * 180.0 / std::f64::consts::PI).to_array();
+        let joints = (model.skeleton.names.iter().enumerate())
+            .map(|(b, name)| JointAngles {
+                name: name.clone(),
+                fitted_deg: deg(self.fit.theta[b]),
+                symmetric_deg: deg(self.symmetric[b]),
+            })
+            .collect();
+        FitReport {
+            joints,
+            beta: self.fit.beta.clone(),
+            translation_mm: self.fit.translation.to_array(),
+            residuals: self.fit.residuals,
+            regions: self.residuals.clone(),
+            iterations: self.fit.iterations,
+            rig_filled_vertices: self.rig.filled,
+        }
+    }
+
+    /// `rigged.glb`: the input scan with the skeleton at its fitted joints and its weights.
+    pub fn rigged_glb(&self, scan: &Scan) -> Vec<u8> {
+        let model = &self.model;
+        let joints = self.fit.joints(model);
+        crate::pose::body_model::file::rigged_to_bytes(
+            &scan.body,
+            &self.rig.weights,
+            &model.skeleton,
+            &joints,
+        )
+    }
+}
