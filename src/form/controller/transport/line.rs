@@ -22,6 +22,14 @@ const READ_TIMEOUT: Duration = Duration::from_millis(10);
 /// The most bytes one read takes from the device: at 1 Mbaud about 10 ms of traffic, what
 /// arrives within one [`READ_TIMEOUT`].
 const READ_CHUNK: usize = 1024;
+/// How long a write beside the device's holder ([`Writer::shared`]) keeps trying while the
+/// device is busy: the kernel refuses a non-blocking write (`EAGAIN`) while the holder's own
+/// write is in progress (the tty's write lock) or while its output buffer is full. The
+/// holder's writes are one frame each, so the lock frees within microseconds; a buffer the
+/// form has not drained for this long will not take the stop either.
+const SHARED_WRITE_PATIENCE: Duration = Duration::from_millis(500);
+/// How long a busy shared write waits before it tries again.
+const SHARED_WRITE_RETRY: Duration = Duration::from_millis(1);
 
 /// The reading side of an open serial device: its reader thread.
 pub struct Line {
@@ -132,7 +140,7 @@ impl Writer {
             .custom_flags(libc::O_NOCTTY | libc::O_NONBLOCK)
             .open(path)
             .map_err(|source| TransportError::Io { device: device.clone(), source })?;
-        Ok(Self { device, port: Box::new(port) })
+        Ok(Self { device, port: Box::new(Patient(port)) })
     }
 
     /// Writes `bytes` in full (each write waits at most [`READ_TIMEOUT`] for the device).
@@ -149,6 +157,38 @@ impl Writer {
     }
 }
 
+/// A non-blocking device written beside its holder: a write the device refuses for now
+/// (`EAGAIN`) is tried again for up to [`SHARED_WRITE_PATIENCE`], so an e-stop is not lost to
+/// the holder writing at the same instant.
+struct Patient(std::fs::File);
+
+impl Write for Patient {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        let deadline = std::time::Instant::now() + SHARED_WRITE_PATIENCE;
+        loop {
+            match self.0.write(bytes) {
+                Err(e) if e.kind() == ErrorKind::WouldBlock => {
+                    if std::time::Instant::now() >= deadline {
+                        return Err(std::io::Error::new(
+                            ErrorKind::WouldBlock,
+                            format!(
+                                "the device took nothing for {} ms ({e})",
+                                SHARED_WRITE_PATIENCE.as_millis()
+                            ),
+                        ));
+                    }
+                    std::thread::sleep(SHARED_WRITE_RETRY);
+                }
+                done => return done,
+            }
+        }
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.flush()
+    }
+}
+
 impl Drop for Line {
     fn drop(&mut self) {
         self.stop.store(true, Ordering::Relaxed);
@@ -157,5 +197,79 @@ impl Drop for Line {
         if let Some(reader) = self.reader.take() {
             let _ = reader.join();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::io::Read;
+    use std::os::fd::{FromRawFd, OwnedFd};
+    use std::os::unix::fs::OpenOptionsExt;
+
+    use super::*;
+
+    /// A pseudo-terminal's controller side and the path of its device side.
+    fn pty() -> (std::fs::File, std::path::PathBuf) {
+        // SAFETY: posix_openpt takes flags only and returns a new descriptor or -1.
+        let fd = unsafe { libc::posix_openpt(libc::O_RDWR | libc::O_NOCTTY) };
+        assert!(fd >= 0, "posix_openpt: {}", std::io::Error::last_os_error());
+        // SAFETY: `fd` was just opened above and is owned by nothing else.
+        let controller = std::fs::File::from(unsafe { OwnedFd::from_raw_fd(fd) });
+        let mut name = [0 as libc::c_char; 128];
+        // SAFETY: `fd` is an open pty controller; `name` is writable for its full length.
+        unsafe {
+            assert_eq!(libc::grantpt(fd), 0);
+            assert_eq!(libc::unlockpt(fd), 0);
+            assert_eq!(libc::ptsname_r(fd, name.as_mut_ptr(), name.len()), 0);
+        }
+        // SAFETY: ptsname_r wrote a NUL-terminated path into `name`.
+        let path = unsafe { std::ffi::CStr::from_ptr(name.as_ptr()) };
+        (controller, path.to_str().unwrap().into())
+    }
+
+    #[test]
+    fn a_shared_write_waits_out_a_busy_device() {
+        let (mut controller, path) = pty();
+        let mut writer = Writer::shared(&path).unwrap();
+        // Fill the device until it takes nothing more: the form has not drained it.
+        let mut filler = std::fs::OpenOptions::new()
+            .write(true)
+            .custom_flags(libc::O_NOCTTY | libc::O_NONBLOCK)
+            .open(&path)
+            .unwrap();
+        let chunk = [b'x'; 256];
+        loop {
+            match filler.write(&chunk) {
+                Ok(_) => {}
+                Err(e) if e.kind() == ErrorKind::WouldBlock => break,
+                Err(e) => panic!("filling {}: {e}", path.display()),
+            }
+        }
+        // The form reads again a moment later.
+        let reader = std::thread::spawn(move || {
+            std::thread::sleep(SHARED_WRITE_PATIENCE / 5);
+            let mut buf = [0u8; 4096];
+            let mut seen = Vec::new();
+            while !seen.ends_with(b"STOP") {
+                let n = controller.read(&mut buf).unwrap();
+                seen.extend_from_slice(&buf[..n]);
+            }
+        });
+        writer.write(b"STOP").expect("the stop waits for the device to drain");
+        reader.join().unwrap();
+    }
+
+    #[test]
+    fn a_shared_write_gives_up_on_a_device_that_takes_nothing() {
+        let (_controller, path) = pty();
+        let mut writer = Writer::shared(&path).unwrap();
+        let chunk = [b'x'; 256];
+        let err = loop {
+            if let Err(e) = writer.write(&chunk) {
+                break e;
+            }
+        };
+        let patience = format!("took nothing for {} ms", SHARED_WRITE_PATIENCE.as_millis());
+        assert!(err.to_string().contains(&patience), "{err}");
     }
 }
