@@ -10,8 +10,8 @@ use std::time::Duration;
 use dressform::form::controller::motion::MAX_SLOWER;
 use dressform::form::controller::simulated::SimConfig;
 use dressform::form::controller::{
-    Claim, DEFAULT_TOLERANCE_MM, DriveError, DriveOptions, DriveReport, LinkSpec, MoveError,
-    Progress, SessionError, plan,
+    DEFAULT_TOLERANCE_MM, DriveAfterError, DriveError, DriveOptions, DriveReport, LinkSpec,
+    MoveError, Progress, SessionError, drive_after, plan,
 };
 use dressform::form::form_fit::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
 use dressform::form::setpoints::SetPoints;
@@ -138,15 +138,10 @@ pub fn shape_verdict(shape: &ShapeOutcome) -> Result<(), Failure> {
 
 /// Drives `form` over `link` (the in-process simulated form for [`LinkSpec::Sim`], with
 /// `sim`'s log and faults) to the set-points `compute` returns, with one progress bar per
-/// node (none with `json`).
-///
-/// The form is claimed before `compute` starts ([`Claim::take`]): the link opened, its
-/// control endpoint answering and the signals armed, every node discovered and the e-stops
-/// latched on it recorded. `compute` then runs on a thread of its own while the link is kept
-/// alive ([`Claim::hold_while`]); an e-stop meanwhile — from another terminal, a signal, or
-/// latched on a node — ends the command at once (exit 1; the computation is abandoned, its
-/// outputs are all or nothing) and is never cleared by it. A failing log is reported when it
-/// fails, and fails the command once the move is over.
+/// node (none with `json`): [`drive_after`] on the link this process owns (its control
+/// endpoint answering and the signals armed before the form is claimed). An e-stop while
+/// `compute` runs ends the command at once (exit 1; its outputs are all or nothing). A failing
+/// log is reported when it fails, and fails the command once the move is over.
 pub fn execute<R: Send + 'static>(
     form: &FormDescription,
     link: &LinkSpec,
@@ -168,52 +163,44 @@ pub fn execute<R: Send + 'static>(
     let result = runtime.block_on(async {
         let config = SimConfig { faults, log: sim.log.clone(), ..SimConfig::default() };
         let owned = link::own(link, form, &config)?;
-        let mut claim = Claim::take(owned.connection, form).await.map_err(DriveError::from)?;
-        let (computed, result) = tokio::sync::oneshot::channel();
-        std::thread::Builder::new()
-            .name("dressform compute".into())
-            .stack_size(COMPUTE_STACK_BYTES)
-            .spawn(move || {
-                // The receiver is gone only when the command already ended (an e-stop).
-                let _ = computed.send(compute());
-            })
-            .map_err(|e| Failure::other(format!("cannot start the computation: {e}")))?;
-        let (value, setpoints) = match claim.hold_while(result).await {
-            Ok(Ok(done)) => done?,
-            Ok(Err(_)) => return Err(Failure::other("the computation ended without a result")),
-            Err(stopped) => return Err(DriveError::from(stopped).into()),
-        };
-        let driving = claim.drive(&setpoints, options, progress);
-        let Some(rig) = owned.rig else {
-            return Ok((value, driving.await?));
-        };
+        let rig = owned.rig;
         // The simulated bus's log, watched while the form moves.
         let log_watch = async {
+            let Some(rig) = &rig else { return };
             loop {
                 tokio::time::sleep(LOG_CHECK).await;
                 if let Some(e) = rig.log_failure() {
                     errln!("error: {e} (the move goes on)");
-                    std::future::pending::<()>().await;
+                    return;
                 }
             }
         };
-        let report = tokio::select! {
-            report = driving => report,
-            () = log_watch => unreachable!("the log watch never ends"),
-        };
-        rig.finish().map_err(link::sim_failure)?;
-        Ok((value, report?))
+        let outcome =
+            drive_after(owned.connection, form, options, compute, progress, log_watch).await;
+        // The log is judged once the form moved (or failed moving).
+        let moved = matches!(outcome, Ok(_) | Err(DriveAfterError::Drive(_)));
+        if moved && let Some(rig) = rig {
+            rig.finish().map_err(link::sim_failure)?;
+        }
+        outcome.map_err(Failure::from)
     });
     display.finish();
     result
 }
 
-/// The computation's stack: as large as the main thread's (8 MiB on Linux), where it ran
-/// before it had a thread of its own.
-const COMPUTE_STACK_BYTES: usize = 8 << 20;
-
 /// How often a simulated bus's log is checked for write errors.
 const LOG_CHECK: Duration = Duration::from_millis(100);
+
+impl From<DriveAfterError<Failure>> for Failure {
+    fn from(e: DriveAfterError<Failure>) -> Self {
+        match e {
+            DriveAfterError::Claim(e) => DriveError::from(e).into(),
+            DriveAfterError::Thread(e) => Failure::other(e),
+            DriveAfterError::Computation(failure) => failure,
+            DriveAfterError::Drive(e) => e.into(),
+        }
+    }
+}
 
 impl From<DriveError> for Failure {
     fn from(e: DriveError) -> Self {

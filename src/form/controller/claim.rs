@@ -24,11 +24,8 @@ use firmware_protocol::NodeId;
 use firmware_protocol::drive::Faults;
 use tokio::time::Instant;
 
-use super::motion::{self, MoveError, Progress};
 use super::session::{Session, SessionError};
 use super::transport::Transport;
-use super::{ANY_FAULT, DriveError, DriveOptions, DriveReport, cleared_notes, faults, plan};
-use crate::form::setpoints::SetPoints;
 use form_description::FormDescription;
 
 /// How long one wait of [`Claim::hold_while`] lasts before it starts the next (the wait ends
@@ -80,80 +77,10 @@ impl<T: Transport> Claim<T> {
         }
     }
 
-    /// Drives the form to `setpoints` (see [`super::drive`]): checks them, clears the latched
-    /// faults [`DriveOptions::reset_faults`] allows — an e-stop only on a node that held it
-    /// when the form was claimed — enables and homes, moves every actuator together, watches
-    /// until all are within tolerance, then disables.
-    pub async fn drive(
-        self,
-        setpoints: &SetPoints,
-        options: &DriveOptions,
-        mut progress: impl FnMut(&Progress),
-    ) -> Result<DriveReport, DriveError> {
-        let Self { mut session, stopped_at_start } = self;
-        let form = session.form().clone();
-        let (plan, clamped) = plan(&form, setpoints, options.clamp)?;
-        let device = session.device();
-        let allowed = if options.reset_faults { ANY_FAULT } else { faults::CLEARED_AT_START };
-        let allowed_on = |node| {
-            if stopped_at_start.contains(&node) {
-                allowed
-            } else {
-                allowed.difference(Faults::EMERGENCY_STOP)
-            }
-        };
-        // The reset judges on fresh heartbeats and sends nothing when it refuses: an e-stop
-        // latched since the start is refused there, and named for what it is.
-        let cleared = match session.reset_faults(allowed_on).await {
-            Err(SessionError::Latched(_))
-                if !newly_stopped(&session, &stopped_at_start).is_empty() =>
-            {
-                let late = newly_stopped(&session, &stopped_at_start);
-                return Err(SessionError::StoppedSinceStart(names(&late)).into());
-            }
-            result => result?,
-        };
-        let remaining: Vec<String> = cleared
-            .iter()
-            .filter(|c| !c.remaining.is_empty())
-            .map(|c| format!("{}: {}", c.node, faults::describe(c.remaining)))
-            .collect();
-        if !remaining.is_empty() {
-            return Err(SessionError::NotCleared(remaining).into());
-        }
-        let mut notes = cleared_notes(&cleared);
-        session.enable_all(options.homing_timeout).await?;
-        let move_options = motion::MoveOptions {
-            tolerance_mm: options.tolerance_mm,
-            slower: options.slower,
-            min_duration: options.min_duration,
-            settle: options.settle,
-        };
-        let started = Instant::now();
-        let result =
-            motion::run(&mut session, &plan, &move_options, options.homing_timeout, &mut progress)
-                .await;
-        let (duration_ms, actuators, warnings) = match result {
-            Ok(done) => done,
-            // A session error is the session's, wherever it happened.
-            Err(MoveError::Session(e)) => return Err(e.into()),
-            Err(e) => return Err(e.into()),
-        };
-        notes.extend(warnings);
-        let elapsed_ms = started.elapsed().as_millis() as u64;
-        let positions_mm = super::positions_of(&session);
-        session.disable_all().await?;
-        let report = DriveReport {
-            form: form.name.clone(),
-            device,
-            duration_ms,
-            elapsed_ms,
-            actuators,
-            positions_mm,
-            clamped,
-            warnings: notes,
-        };
-        if report.converged() { Ok(report) } else { Err(DriveError::NotReached(Box::new(report))) }
+    /// The session and the nodes that held a latched e-stop when the form was claimed: what
+    /// the drive ([`Claim::drive`]) goes on from.
+    pub(super) fn into_parts(self) -> (Session<T>, BTreeSet<NodeId>) {
+        (self.session, self.stopped_at_start)
     }
 }
 
@@ -168,7 +95,7 @@ fn estopped<T: Transport>(session: &Session<T>) -> BTreeSet<NodeId> {
 }
 
 /// The nodes holding a latched e-stop that they did not hold at the start.
-fn newly_stopped<T: Transport>(
+pub(super) fn newly_stopped<T: Transport>(
     session: &Session<T>,
     stopped_at_start: &BTreeSet<NodeId>,
 ) -> Vec<NodeId> {
@@ -176,6 +103,6 @@ fn newly_stopped<T: Transport>(
 }
 
 /// The nodes' addresses for a message (eight names would not fit its line).
-fn names(nodes: &[NodeId]) -> Vec<u8> {
+pub(super) fn names(nodes: &[NodeId]) -> Vec<u8> {
     nodes.iter().map(|n| n.get()).collect()
 }

@@ -29,6 +29,8 @@
 //!
 //! One endpoint per device: binding where one is bound is refused (two owners of one link is
 //! a mistake even on a pseudo-terminal that allows it).
+//!
+//! Beside it, [`emergency_stop`]: the same stop from this process, on a link it opened itself.
 
 use std::io::{self, BufRead, BufReader, Read, Write};
 use std::os::fd::AsRawFd;
@@ -39,7 +41,7 @@ use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::time::Duration;
 
 use super::transport::LinkSpec;
-use super::transport::{Gate, StopCause};
+use super::transport::{Gate, StopCause, Transport, TransportError};
 
 /// How long the endpoint waits for a client's request line, and for the client to take its
 /// answer.
@@ -259,7 +261,7 @@ impl Endpoint {
 
     /// From now on, e-stops go to `gate`; one that came while the link was opening is sent
     /// now, before the caller can send anything.
-    pub fn arm(&self, gate: &Gate) -> Result<(), super::transport::TransportError> {
+    pub fn arm(&self, gate: &Gate) -> Result<(), TransportError> {
         let mut slot = self.gate.lock().unwrap_or_else(PoisonError::into_inner);
         let pending = matches!(*slot, Slot::StopWhenOpen);
         *slot = Slot::Open(gate.clone());
@@ -380,6 +382,12 @@ pub fn request_estop(spec: &LinkSpec) -> Result<Option<Owner>, ControlError> {
         }
         None => Err(failed(format!("(pid {}) {reply}", owner.pid))),
     }
+}
+
+/// Broadcasts an emergency stop on a link this process opened (see [`Gate`]): every
+/// node stops, powers off and latches `EMERGENCY_STOP` until a FaultReset.
+pub fn emergency_stop<T: Transport>(transport: &T) -> Result<(), TransportError> {
+    transport.gate().emergency_stop(StopCause::Requested)
 }
 
 #[cfg(test)]

@@ -17,6 +17,10 @@ use firmware_protocol::drive::{AckStatus, DriveState, EmergencyCode, Faults};
 /// hardware.
 pub const CLEARED_AT_START: Faults = Faults::EMERGENCY_STOP.union(Faults::HOST_TIMEOUT);
 
+/// Every fault flag, the reserved bits included: what `reset_faults` may clear (`dressform
+/// reset`, `--reset-faults`).
+pub(super) const ANY_FAULT: Faults = Faults::from_bits_retain(u16::MAX);
+
 /// The name of a drive state.
 pub fn state_name(state: DriveState) -> &'static str {
     match state {
