@@ -106,6 +106,24 @@ fn slice_and_info_work_in_the_scans_frame() {
 }
 
 #[test]
+fn a_mannequin_is_never_smoothed() {
+    // A mannequin dressform made has no scanner noise: every command takes it as it is
+    // (`scan::prepare`), whatever smoothing is asked for. `slice` smoothed it before.
+    let tmp = tempfile::tempdir().unwrap();
+    let scan = synthetic_scan(tmp.path(), 9);
+    let out = tmp.path().join("out");
+    let coarse = ["--torso-layers", "20", "--leg-layers", "10", "--rays", "60"];
+    let written = symmetrize(&scan, &out, &coarse);
+    let mannequin = out.join("mannequin.obj");
+    let chest = format!("{}", f(&written["table"][0]["mannequin"]["z_mm"]));
+    let slice = |smooth: &str| {
+        let file = mannequin.to_str().unwrap();
+        json(&run_ok(&["slice", file, "--heights", &chest, "--smooth", smooth, "--json"]))
+    };
+    assert_eq!(slice("8"), slice("0"));
+}
+
+#[test]
 fn an_stl_mannequin_has_no_header_and_is_refused_clearly() {
     let tmp = tempfile::tempdir().unwrap();
     let scan = synthetic_scan(tmp.path(), 7);

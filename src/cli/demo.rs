@@ -12,12 +12,12 @@ use super::{Failure, progress_bar};
 use dressform::atomic_output::OutputSet;
 use dressform::body::mesh::{Mesh, smooth::DEFAULT_PASSES};
 use dressform::body::scan::format::{Export, Format, Placement};
-use dressform::body::scan::{self, frame::FrameOptions, frame::Units};
+use dressform::body::scan::{self, PreparedScan, frame::FrameOptions, frame::Units};
 use dressform::form::controller::{DriveOptions, LinkSpec};
 use dressform::form::form_fit::DEFAULT_GIRTH_TOLERANCE_MM;
 use dressform::pose::body_model::BodyModel;
 use dressform::run::info::ScanInfo;
-use dressform::run::reconstruct::ReconstructOptions;
+use dressform::run::reconstruct::{MeasurementsReport, ReconstructOptions};
 use glam::DVec3;
 use sim::capture::{Artifacts, BodyParams, GroundTruth, Pose, capture, generate};
 use std::path::{Path, PathBuf};
@@ -70,7 +70,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         "mannequin"
     );
     let c = &done.shaped.symmetrized.comparison;
-    let scanned = done.reposed.scan_measurements.as_ref();
+    let scanned = done.as_scanned.measurements.as_ref();
     let mm = |g: Option<f64>| g.map_or_else(|| "-".to_string(), |g| format!("{g:.1}"));
     outln!(
         "  {:<12} {:>9.1} {:>9} {:>11.1} {:>11}",
@@ -80,7 +80,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         c.input.height,
         "-"
     );
-    let three = done.reposed.measurements(c).table;
+    let three = MeasurementsReport::new(&done.as_scanned, c).table;
     for (row, asked) in three.iter().zip([truth.chest, truth.waist, truth.hip]) {
         outln!(
             "  {:<12} {:>9.1} {:>9} {:>11.1} {:>11.1}",
@@ -123,12 +123,13 @@ fn customer(seed: Option<u64>, out: &Path) -> Result<Prepared<GroundTruth>, Fail
     let scan_path = out.join("scan.ply");
     bar.inc(1);
     bar.set_message("reading the scan back");
-    let mut scan = scan::from_bytes(&scan_file, &scan_path, &FrameOptions::default())
+    let scan = scan::from_bytes(&scan_file, &scan_path, &FrameOptions::default())
         .map_err(Failure::bad_input)?;
     let mut outputs = OutputSet::new();
     outputs.add("scan.ply", scan_file);
+    // The report on the scan as read (its warnings among it), before it is smoothed.
     let info = ScanInfo::new(&scan);
-    scan.body.taubin_smooth(DEFAULT_PASSES);
+    let scan = PreparedScan::new(scan, DEFAULT_PASSES).scan;
     bar.finish_and_clear();
 
     let truth = &customer.truth;

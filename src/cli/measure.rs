@@ -1,16 +1,10 @@
 //! `dressform measure <mesh or directory>... [--json | --csv] [--at z,...]`: one scan, or
 //! several measured in parallel (one row each).
 
-use super::{Failure, FrameArgs, SmoothArgs, warn};
-use dressform::body::regions::Landmarks;
-use dressform::body::scan;
-use dressform::body::segmented_body::SegmentedBody;
-use dressform::shape::measure::{
-    BodyDimensions, Girth, Levels, Measurements, contact_warnings, dimensions, find_levels,
-    measure_at, warnings,
-};
+use super::{Failure, FrameArgs, SmoothArgs, print_warnings, warn};
+use dressform::body::scan::{self, ScanOptions};
+use dressform::shape::measure::{MeasureReport, measure_scan};
 use rayon::prelude::*;
-use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]
@@ -31,20 +25,6 @@ pub struct MeasureArgs {
     frame: FrameArgs,
     #[command(flatten)]
     smooth: SmoothArgs,
-}
-
-#[derive(Serialize)]
-struct MeasureOut {
-    file: String,
-    landmarks: Landmarks,
-    levels: Levels,
-    measurements: Measurements,
-    /// The ISO 8559-1 body dimensions.
-    dimensions: BodyDimensions,
-    /// Torso girths at the requested heights (`null` where there is no torso).
-    at: Vec<Option<Girth>>,
-    /// Where a number is unreliable.
-    warnings: Vec<String>,
 }
 
 /// The scan files `paths` name: files as given, directories' .obj, .ply and .stl files.
@@ -73,48 +53,14 @@ fn scan_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, Failure> {
     Ok(files)
 }
 
-fn measure_one(path: &Path, args: &MeasureArgs) -> Result<MeasureOut, Failure> {
-    let mut scan = scan::load(path, &args.frame.options()).map_err(Failure::bad_input)?;
-    let file = scan.source.display().to_string();
-    for w in scan.cleaning.warnings() {
-        warn(&file, &w);
-    }
-    // A mannequin dressform made is measured as it is (it has no scanner noise to smooth
-    // away), at the levels and with the landmarks its file carries.
-    if scan.carried.is_none() {
-        scan.body.taubin_smooth(args.smooth.smooth);
-    }
-    let (body, levels, fallbacks) = match scan.carried {
-        Some(carried) => {
-            (SegmentedBody::armless(&scan.body, carried.landmarks), carried.levels, Vec::new())
-        }
-        None => {
-            let body = SegmentedBody::find(&scan.body)
-                .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
-            let found = find_levels(&body);
-            (body, found.levels, found.fallbacks)
-        }
-    };
-    let measurements = measure_at(&body, &levels);
-    let dimensions = dimensions(&body, &levels);
-    let mut warnings = warnings(&scan.body, &levels);
-    warnings.extend(contact_warnings(body.landmarks(), &levels));
-    warnings.extend(fallbacks);
-    let at = body
-        .torso_sections(&args.at)
-        .into_iter()
-        .zip(&args.at)
-        .map(|(l, &z)| l.map(|c| Girth { z, tape: c.tape_girth(), contour: c.perimeter() }))
-        .collect();
-    Ok(MeasureOut {
-        file,
-        landmarks: *body.landmarks(),
-        levels,
-        measurements,
-        dimensions,
-        at,
-        warnings,
-    })
+/// Reads, prepares (see [`scan::prepare`]) and measures one scan; its scan's warnings are
+/// printed as it is read.
+fn measure_one(path: &Path, args: &MeasureArgs) -> Result<MeasureReport, Failure> {
+    let options = ScanOptions { frame: args.frame.options(), smooth: args.smooth.smooth };
+    let prepared = scan::prepare(path, &options).map_err(Failure::bad_input)?;
+    let file = prepared.scan.source.display().to_string();
+    print_warnings(&file, &prepared.warnings, None);
+    measure_scan(&prepared.scan, &args.at).map_err(|e| Failure::bad_input(format!("{file}: {e}")))
 }
 
 /// The scalar fields of a JSON object, flattened to `a.b` names, in order.
@@ -137,14 +83,14 @@ fn flatten(prefix: &str, v: &serde_json::Value, out: &mut Vec<(String, String)>)
 }
 
 /// One CSV row of a scan: its file and every dimension.
-fn csv_row(m: &MeasureOut) -> Result<Vec<(String, String)>, Failure> {
+fn csv_row(m: &MeasureReport) -> Result<Vec<(String, String)>, Failure> {
     let mut row = vec![("file".to_string(), format!("\"{}\"", m.file.replace('"', "\"\"")))];
     let dims = serde_json::to_value(&m.dimensions).map_err(Failure::other)?;
     flatten("", &dims, &mut row);
     Ok(row)
 }
 
-fn print_text(m: &MeasureOut, at: &[f64]) {
+fn print_text(m: &MeasureReport, at: &[f64]) {
     let d = &m.dimensions;
     outln!("{}", m.file);
     let g = |name: &str, v: f64| {
@@ -216,7 +162,7 @@ pub fn run(args: &MeasureArgs) -> Result<(), Failure> {
         return Err(Failure::bad_input(format!("--at: {h} is not a height")));
     }
     let files = scan_files(&args.meshes)?;
-    let results: Vec<Result<MeasureOut, Failure>> =
+    let results: Vec<Result<MeasureReport, Failure>> =
         files.par_iter().map(|f| measure_one(f, args)).collect();
     // Every scan is measured; the first that failed decides the exit status.
     let mut done = Vec::with_capacity(results.len());

@@ -383,6 +383,17 @@ fn warn(file: &str, message: &str) {
     errln!("warning: {}", messages::bounded(&format!("{file}: {message}")));
 }
 
+/// Prints `warnings` about `file` (a prepared scan's: see [`dressform::body::scan::prepare`]),
+/// in their order; through `bar`, when one is showing, so that they do not tear it.
+fn print_warnings(file: &str, warnings: &[String], bar: Option<&indicatif::ProgressBar>) {
+    for w in warnings {
+        match bar {
+            Some(bar) => bar.suspend(|| warn(file, w)),
+            None => warn(file, w),
+        }
+    }
+}
+
 /// A progress bar on standard error for `steps` steps; hidden in `--json` mode and when
 /// standard error is not a terminal.
 fn progress_bar(json: bool, steps: u64) -> indicatif::ProgressBar {

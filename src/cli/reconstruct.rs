@@ -3,14 +3,17 @@
 //! mannequin (see [`dressform::run::reconstruct`]).
 
 use super::symmetrize::pretty_json;
-use super::{ExportArgs, Failure, MannequinArgs, ScanFrameArgs, SmoothArgs, progress_bar, warn};
-use dressform::body::mesh::topology;
-use dressform::body::scan;
+use super::{
+    ExportArgs, Failure, MannequinArgs, ScanFrameArgs, SmoothArgs, print_warnings, progress_bar,
+};
+use dressform::body::scan::{self, ScanOptions};
 use dressform::pose::body_model::BodyModel;
 use dressform::pose::pose_symmetry::PoseOverrides;
 use dressform::run::outputs::Outputs;
 use dressform::run::pipeline;
-use dressform::run::reconstruct::{ReconstructOptions, Reconstruction, STEPS, reconstruct};
+use dressform::run::reconstruct::{
+    MeasurementsReport, ReconstructOptions, Reconstruction, STEPS, reconstruct,
+};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]
@@ -47,13 +50,12 @@ pub fn run(args: &ReconstructArgs) -> Result<(), Failure> {
     bar.set_message("reading the scan");
     let model = super::model::load(args.model.as_deref())?;
     let pose = pose_overrides(args.pose.as_deref(), &model)?;
-    let mut scan = scan::load(&args.scan, &args.frame.options()).map_err(Failure::bad_input)?;
+    let options = ScanOptions { frame: args.frame.options(), smooth: args.smooth.smooth };
+    let scan::PreparedScan { scan, warnings, .. } =
+        scan::prepare(&args.scan, &options).map_err(Failure::bad_input)?;
     let export = args.export.export(&scan)?;
-    scan.body.taubin_smooth(args.smooth.smooth);
     let file = scan.source.display().to_string();
-    for w in scan.cleaning.warnings().into_iter().chain(topology(&scan.body).warnings()) {
-        bar.suspend(|| warn(&file, &w));
-    }
+    print_warnings(&file, &warnings, Some(&bar));
     let options =
         ReconstructOptions { pose, mannequin: args.mannequin.options(), ..Default::default() };
     let done = reconstruct(&scan, &model, &options, |step| {
@@ -64,7 +66,7 @@ pub fn run(args: &ReconstructArgs) -> Result<(), Failure> {
     bar.inc(1);
     bar.set_message("writing");
 
-    let outputs = Outputs::reposed(&done.result, &done.reposed, &scan, &export);
+    let outputs = Outputs::reposed(&done.result, &done.reposed, &done.as_scanned, &scan, &export);
     outputs.files().map_err(Failure::other)?.commit(&args.out).map_err(Failure::other)?;
     bar.finish_and_clear();
     if args.json {
@@ -97,7 +99,7 @@ fn print_summary(file: &str, done: &Reconstruction, args: &ReconstructArgs) {
         worst
     );
     outln!("  {:<6} {:>12} {:>15} {:>12}", "", "scan (mm)", "pose-symm.", "mannequin");
-    for row in &reposed.measurements(&done.result.comparison).table {
+    for row in &MeasurementsReport::new(&done.as_scanned, &done.result.comparison).table {
         let scan = row.scan.map_or("-".to_string(), |g| format!("{:.1}", g.tape));
         outln!(
             "  {:<6} {:>12} {:>15.1} {:>12.1}",

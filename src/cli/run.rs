@@ -9,10 +9,9 @@
 use super::drive::{ShapeArgs, SimArgs, execute, shape_verdict};
 use super::link::{FormArg, LinkArgs};
 use super::setpoints::fidelity_table;
-use super::{Failure, FrameArgs, SmoothArgs, progress_bar, warn};
+use super::{Failure, FrameArgs, SmoothArgs, print_warnings, progress_bar};
 use dressform::atomic_output::OutputSet;
-use dressform::body::mesh::topology;
-use dressform::body::scan::{self, Scan, format::Export, format::Format};
+use dressform::body::scan::{self, Scan, ScanOptions, format::Export, format::Format};
 use dressform::form::controller::{DriveOptions, LinkSpec};
 use dressform::form::form_fit::{ShapeOutcome, compare};
 use dressform::pose::body_model::BodyModel;
@@ -58,17 +57,15 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     let drive =
         Drive { link: &link, sim: &args.sim, options: &args.shape.options(), girth_tolerance };
     // Read and checked once the form is claimed (see `shape_form`): nothing here moves it.
-    let (scan_path, frame, smooth) = (args.scan.clone(), args.frame.options(), args.smooth.smooth);
+    let scan_path = args.scan.clone();
+    let scan_options = ScanOptions { frame: args.frame.options(), smooth: args.smooth.smooth };
     let (model_path, pose_path) = (args.model.clone(), args.pose.clone());
     let prepare = move || {
         let model = super::model::load(model_path.as_deref())?;
         let pose = super::reconstruct::pose_overrides(pose_path.as_deref(), &model)?;
-        let mut scan = scan::load(&scan_path, &frame).map_err(Failure::bad_input)?;
-        let file = scan.source.display().to_string();
-        for w in scan.cleaning.warnings().into_iter().chain(topology(&scan.body).warnings()) {
-            warn(&file, &w);
-        }
-        scan.body.taubin_smooth(smooth);
+        let scan::PreparedScan { scan, warnings, .. } =
+            scan::prepare(&scan_path, &scan_options).map_err(Failure::bad_input)?;
+        print_warnings(&scan.source.display().to_string(), &warnings, None);
         let options = ReconstructOptions { pose, ..Default::default() };
         let reconstruct = Reconstruct { model, options };
         Ok(Prepared { scan, reconstruct, outputs: OutputSet::new(), extra: () })
@@ -100,7 +97,7 @@ pub struct Reconstruct {
 /// What `run` and `demo` prepare before the reconstruction: the scan, how to reconstruct it,
 /// the output files made on the way, and anything else the caller wants back (`extra`).
 pub struct Prepared<X> {
-    /// The scan, in the canonical frame and smoothed.
+    /// The scan, in the canonical frame and prepared ([`scan::prepare`]).
     pub scan: Scan,
     /// The body model and options.
     pub reconstruct: Reconstruct,
@@ -185,8 +182,9 @@ fn reconstruct_and_write(
     })
     .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
     let (shaped, export) = (&done.shaped, Export::canonical(Format::Obj));
-    let files = Outputs::reposed(&shaped.symmetrized, &done.reposed, scan, &export)
-        .with_setpoints(&shaped.setpoints);
+    let files =
+        Outputs::reposed(&shaped.symmetrized, &done.reposed, &done.as_scanned, scan, &export)
+            .with_setpoints(&shaped.setpoints);
     outputs.append(files.files().map_err(Failure::other)?);
     outputs.commit(out).map_err(Failure::other)?;
     bar.finish_and_clear();

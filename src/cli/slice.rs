@@ -1,8 +1,8 @@
 //! `dressform slice <mesh> --heights 900,950,... [--json]`.
 
-use super::{Failure, FrameArgs, warn};
+use super::{Failure, FrameArgs, print_warnings, warn};
 use dressform::body::regions::Region;
-use dressform::body::scan;
+use dressform::body::scan::{self, ScanOptions};
 use dressform::body::segmented_body::SegmentedBody;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -21,7 +21,7 @@ pub struct SliceArgs {
     #[command(flatten)]
     frame: FrameArgs,
     /// Taubin smoothing passes applied before cutting, 0 to 100 (default 0: the scan as it
-    /// is; the commands that measure use 8).
+    /// is; the commands that measure use 8). A mannequin dressform made is never smoothed.
     #[arg(long, default_value_t = 0, value_parser = super::passes_parser())]
     smooth: usize,
 }
@@ -52,12 +52,11 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
     if let Some(h) = args.heights.iter().find(|h| !h.is_finite()) {
         return Err(Failure::bad_input(format!("--heights: {h} is not a height")));
     }
-    let mut scan = scan::load(&args.mesh, &args.frame.options()).map_err(Failure::bad_input)?;
-    scan.body.taubin_smooth(args.smooth);
+    let options = ScanOptions { frame: args.frame.options(), smooth: args.smooth };
+    let scan::PreparedScan { scan, warnings, .. } =
+        scan::prepare(&args.mesh, &options).map_err(Failure::bad_input)?;
     let file = scan.source.display().to_string();
-    for w in scan.cleaning.warnings() {
-        warn(&file, &w);
-    }
+    print_warnings(&file, &warnings, None);
     let (body, sections) = match scan.carried {
         // A mannequin dressform made: labelled by the landmarks its file carries.
         Some(carried) => {

@@ -2,9 +2,10 @@
 //! [--preserve tape|contour] [--format obj|ply|stl|glb] [--units mm|cm|m] [--up z|y]
 //! [--scan-frame] [--json]`.
 
-use super::{ExportArgs, Failure, MannequinArgs, ScanFrameArgs, SmoothArgs, progress_bar, warn};
-use dressform::body::mesh::topology;
-use dressform::body::scan;
+use super::{
+    ExportArgs, Failure, MannequinArgs, ScanFrameArgs, SmoothArgs, print_warnings, progress_bar,
+};
+use dressform::body::scan::{self, ScanOptions};
 use dressform::run::outputs::Outputs;
 use dressform::run::pipeline::{STEPS, symmetrize};
 use dressform::shape::measure::Comparison;
@@ -34,13 +35,12 @@ pub struct SymmetrizeArgs {
 pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     let bar = progress_bar(args.json, STEPS.len() as u64 + 2);
     bar.set_message("reading the scan");
-    let mut scan = scan::load(&args.scan, &args.frame.options()).map_err(Failure::bad_input)?;
+    let options = ScanOptions { frame: args.frame.options(), smooth: args.smooth.smooth };
+    let scan::PreparedScan { scan, warnings, .. } =
+        scan::prepare(&args.scan, &options).map_err(Failure::bad_input)?;
     let export = args.export.export(&scan)?;
-    scan.body.taubin_smooth(args.smooth.smooth);
     let file = scan.source.display().to_string();
-    for w in scan.cleaning.warnings().into_iter().chain(topology(&scan.body).warnings()) {
-        bar.suspend(|| warn(&file, &w));
-    }
+    print_warnings(&file, &warnings, Some(&bar));
     let options = args.mannequin.options();
     let result = symmetrize(&scan, &options, |step| {
         bar.inc(1);

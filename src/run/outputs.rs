@@ -19,7 +19,7 @@ use crate::body::scan::format::Export;
 use crate::form::setpoints::SetPoints;
 use crate::run::pipeline::Symmetrized;
 use crate::run::preview::{preview_png, sections_svg};
-use crate::run::reconstruct::Reposed;
+use crate::run::reconstruct::{AsScanned, MeasurementsReport, Reposed};
 
 /// The mannequin's file name without its extension (the export adds it).
 pub const MANNEQUIN: &str = "mannequin";
@@ -49,8 +49,9 @@ pub struct Outputs<'a> {
     scan: &'a Scan,
     export: &'a Export,
     setpoints: Option<&'a SetPoints>,
-    /// The input scan and how it was re-posed, after pose symmetry.
-    reposed: Option<(&'a Scan, &'a Reposed)>,
+    /// The input scan, how it was re-posed and what it measured as it stood, after pose
+    /// symmetry.
+    reposed: Option<(&'a Scan, &'a Reposed, &'a AsScanned)>,
 }
 
 impl<'a> Outputs<'a> {
@@ -60,15 +61,17 @@ impl<'a> Outputs<'a> {
     }
 
     /// The files of `result`, the mannequin of the pose-symmetric scan of `reposed`, made from
-    /// the scan `input` (canonical frame, as fitted); the mannequin and the pose-symmetric scan
-    /// written as `export` says.
+    /// the scan `input` (canonical frame, as fitted), which measured `as_scanned` as it stood;
+    /// the mannequin and the pose-symmetric scan written as `export` says.
     pub fn reposed(
         result: &'a Symmetrized,
         reposed: &'a Reposed,
+        as_scanned: &'a AsScanned,
         input: &'a Scan,
         export: &'a Export,
     ) -> Self {
-        Outputs { reposed: Some((input, reposed)), ..Self::of(result, &reposed.posed, export) }
+        let of = Self::of(result, &reposed.posed, export);
+        Outputs { reposed: Some((input, reposed, as_scanned)), ..of }
     }
 
     /// With the set-points of a form fitted to the mannequin.
@@ -91,8 +94,8 @@ impl<'a> Outputs<'a> {
                 set.add(MEASUREMENTS, serde_json::to_vec_pretty(&result.comparison)?);
                 set.add(PREVIEW, preview_png(&[(&scan.body, "scan")], result));
             }
-            Some((input, reposed)) => {
-                let measurements = reposed.measurements(&result.comparison);
+            Some((input, reposed, as_scanned)) => {
+                let measurements = MeasurementsReport::new(as_scanned, &result.comparison);
                 set.add(MEASUREMENTS, serde_json::to_vec_pretty(&measurements)?);
                 let bodies = [(&input.body, "scan"), (&scan.body, "pose-symmetric")];
                 set.add(PREVIEW, preview_png(&bodies, result));

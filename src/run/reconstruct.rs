@@ -1,8 +1,8 @@
 //! Scan to mannequin with pose symmetry first (the paper's whole of section 3): fit the body
 //! model to the scan (eq. 4), give the scan the model's rig, re-pose it symmetric (eq. 3)
-//! ([`repose`]), then the shape symmetry of that: the mannequin alone ([`reconstruct`], for
-//! `reconstruct`) or the mannequin with the form fitted to it ([`reconstruct_shape`], for `run`
-//! and `demo`).
+//! ([`repose`]), measure the scan as it stood ([`measure_as_scanned`]), then the shape symmetry
+//! of the pose-symmetric scan: the mannequin alone ([`reconstruct`], for `reconstruct`) or the
+//! mannequin with the form fitted to it ([`reconstruct_shape`], for `run` and `demo`).
 
 use crate::body::regions::BodyRegions;
 use crate::body::scan::Scan;
@@ -30,10 +30,17 @@ pub struct ReconstructOptions {
     pub mannequin: MannequinOptions,
 }
 
-/// The steps of [`repose`], reported to `progress` as they start; [`reconstruct`] goes on with
-/// [`pipeline::STEPS`], [`reconstruct_shape`] with [`pipeline::SHAPE_STEPS`].
-pub const STEPS: [&str; 3] =
+/// The steps of [`repose`], reported to `progress` as they start.
+pub const REPOSE_STEPS: [&str; 3] =
     ["fitting the body model", "transferring the rig", "re-posing the scan symmetric"];
+
+/// The step of [`measure_as_scanned`].
+pub const AS_SCANNED_STEP: &str = "measuring the scan as it stood";
+
+/// The steps of [`reconstruct`] and [`reconstruct_shape`] before the mannequin's: those of
+/// [`repose`], then [`measure_as_scanned`]; [`reconstruct`] goes on with [`pipeline::STEPS`],
+/// [`reconstruct_shape`] with [`pipeline::SHAPE_STEPS`].
+pub const STEPS: [&str; 4] = [REPOSE_STEPS[0], REPOSE_STEPS[1], REPOSE_STEPS[2], AS_SCANNED_STEP];
 
 /// A scan re-posed symmetric: what [`repose`] made.
 #[derive(Debug, Clone)]
@@ -51,19 +58,28 @@ pub struct Reposed {
     pub rig: RigTransfer,
     /// The pose-symmetric scan (same vertices and triangles as the input, moved).
     pub posed: Scan,
-    /// The input scan's segmentation, where it can be segmented as it stands.
-    pub scan_regions: Option<BodyRegions>,
-    /// The input scan's own measurements, where it can be segmented as it stands.
-    pub scan_measurements: Option<Measurements>,
     /// The fit's wall time (s).
     pub fit_seconds: f64,
 }
 
-/// What [`reconstruct`] made: the re-posed scan and its mannequin.
+/// The input scan measured as it stood, before pose symmetry: what [`measure_as_scanned`]
+/// found, the scan's column of `measurements.json` and of the ring table.
+#[derive(Debug, Clone)]
+pub struct AsScanned {
+    /// The scan's segmentation, where it can be segmented as it stands.
+    pub regions: Option<BodyRegions>,
+    /// The scan's own measurements, where it can be segmented as it stands.
+    pub measurements: Option<Measurements>,
+}
+
+/// What [`reconstruct`] made: the re-posed scan, the input measured as it stood and the
+/// mannequin.
 #[derive(Debug, Clone)]
 pub struct Reconstruction {
     /// The fit and the pose-symmetric scan.
     pub reposed: Reposed,
+    /// The input scan as it stood.
+    pub as_scanned: AsScanned,
     /// The pose-symmetric scan's mannequin and measurements.
     pub result: Symmetrized,
 }
@@ -74,6 +90,8 @@ pub struct Reconstruction {
 pub struct Reshaped {
     /// The fit and the pose-symmetric scan.
     pub reposed: Reposed,
+    /// The input scan as it stood.
+    pub as_scanned: AsScanned,
     /// The mannequin of the pose-symmetric scan, the form's fit and set-points, and the
     /// pose-symmetric scan's and the mannequin's girths at every ring.
     pub shaped: Shaped,
@@ -101,7 +119,7 @@ pub enum ReconstructError {
 }
 
 /// Fits `model` to `scan` (canonical frame), gives the scan the model's rig and re-poses it
-/// symmetric, calling `progress(step)` before each of [`STEPS`]. A fit that does not match
+/// symmetric, calling `progress(step)` before each of [`REPOSE_STEPS`]. A fit that does not match
 /// the scan is an error ([`NotConverged`]), never a re-posed body.
 pub fn repose(
     scan: &Scan,
@@ -144,21 +162,35 @@ pub fn repose(
     let drop = feet_drop(model, &fitted, &symmetric);
     posed.frame.translate(&mut posed.body, DVec3::Z * drop);
     posed.frame.centre_on_torso(&mut posed.body);
+    Ok(Reposed { model: extended, fit: fitted, symmetric, residuals, rig, posed, fit_seconds })
+}
 
-    let scan_body = SegmentedBody::find(body).ok();
-    let scan_measurements = scan_body.as_ref().map(|body| measure_at(body, &levels(body)));
-    let scan_regions = scan_body.map(SegmentedBody::into_regions);
-    Ok(Reposed {
-        model: extended,
-        fit: fitted,
-        symmetric,
-        residuals,
-        rig,
-        posed,
-        scan_regions,
-        scan_measurements,
-        fit_seconds,
-    })
+/// Measures `scan` (canonical frame) as it stands, where it can be segmented so: the column
+/// the pose-symmetric scan's measurements are compared with.
+pub fn measure_as_scanned(scan: &Scan) -> AsScanned {
+    let body = SegmentedBody::find(&scan.body).ok();
+    let measurements = body.as_ref().map(|body| measure_at(body, &levels(body)));
+    AsScanned { regions: body.map(SegmentedBody::into_regions), measurements }
+}
+
+impl AsScanned {
+    /// The tape girth of `scan` (the body this was measured on) for each ring of `form`, at
+    /// the body heights `heights` give, as [`pipeline::girths_at_rings`]; all `None` where the
+    /// scan could not be segmented as it stood.
+    pub fn girths_at_rings(
+        &self,
+        scan: &Scan,
+        form: &FormDescription,
+        heights: &[f64],
+    ) -> Vec<Option<f64>> {
+        match &self.regions {
+            Some(regions) => {
+                let body = SegmentedBody::with_regions(&scan.body, regions);
+                pipeline::girths_at_rings(&body, form, heights)
+            }
+            None => vec![None; heights.len()],
+        }
+    }
 }
 
 /// Reconstructs the mannequin of `scan` (canonical frame) with `model`, calling
@@ -170,14 +202,16 @@ pub fn reconstruct(
     mut progress: impl FnMut(usize),
 ) -> Result<Reconstruction, ReconstructError> {
     let reposed = repose(scan, model, options, &mut progress)?;
+    progress(REPOSE_STEPS.len());
+    let as_scanned = measure_as_scanned(scan);
     let result =
         pipeline::symmetrize(&reposed.posed, &options.mannequin, |s| progress(STEPS.len() + s))?;
-    Ok(Reconstruction { reposed, result })
+    Ok(Reconstruction { reposed, as_scanned, result })
 }
 
-/// The whole chain of `run` and `demo`: [`repose`], then the mannequin of the pose-symmetric
-/// scan with `form` fitted to it ([`pipeline::shape`]), and the input scan's girths at the
-/// rings beside the pose-symmetric scan's; `progress(step)` before each step (indices into
+/// The whole chain of `run` and `demo`: [`repose`], [`measure_as_scanned`], then the mannequin
+/// of the pose-symmetric scan with `form` fitted to it ([`pipeline::shape`]), and the input
+/// scan's girths at the rings beside the pose-symmetric scan's; `progress(step)` before each step (indices into
 /// [`STEPS`] then [`pipeline::SHAPE_STEPS`]).
 pub fn reconstruct_shape(
     scan: &Scan,
@@ -187,6 +221,8 @@ pub fn reconstruct_shape(
     mut progress: impl FnMut(usize),
 ) -> Result<Reshaped, ReconstructError> {
     let reposed = repose(scan, model, options, &mut progress)?;
+    progress(REPOSE_STEPS.len());
+    let as_scanned = measure_as_scanned(scan);
     let shaped =
         pipeline::shape(&reposed.posed, &options.mannequin, form, |s| progress(STEPS.len() + s))?;
     // The pose-symmetric scan's frame is the input's moved by the feet's drop (and centred):
@@ -194,14 +230,8 @@ pub fn reconstruct_shape(
     let dz =
         reposed.posed.frame.file_frame().translation[2] - scan.frame.file_frame().translation[2];
     let heights: Vec<f64> = shaped.rings.iter().map(|r| r.body_z_mm - dz).collect();
-    let scan_rings = match &reposed.scan_regions {
-        Some(regions) => {
-            let body = SegmentedBody::with_regions(&scan.body, regions);
-            pipeline::girths_at_rings(&body, form, &heights)
-        }
-        None => vec![None; heights.len()],
-    };
-    Ok(Reshaped { reposed, shaped, scan_rings })
+    let scan_rings = as_scanned.girths_at_rings(scan, form, &heights);
+    Ok(Reshaped { reposed, as_scanned, shaped, scan_rings })
 }
 
 /// How far re-posing from `fitted.theta` to `symmetric` lowers the feet (mm; negative when it
@@ -273,10 +303,11 @@ pub struct JointAngles {
     pub symmetric_deg: [f64; 3],
 }
 
-impl Reposed {
-    /// `measurements.json` of the pose-symmetric scan's `comparison` with its mannequin.
-    pub fn measurements<'a>(&'a self, c: &'a Comparison) -> MeasurementsReport<'a> {
-        let scan = self.scan_measurements.as_ref();
+impl<'a> MeasurementsReport<'a> {
+    /// `measurements.json`: the scan `as_scanned`, and the pose-symmetric scan's comparison
+    /// `c` with its mannequin.
+    pub fn new(as_scanned: &'a AsScanned, c: &'a Comparison) -> MeasurementsReport<'a> {
+        let scan = as_scanned.measurements.as_ref();
         let table = c
             .table
             .iter()
@@ -293,7 +324,9 @@ impl Reposed {
             .collect();
         MeasurementsReport { table, scan, pose_symmetric: c }
     }
+}
 
+impl Reposed {
     /// `fit.json`.
     pub fn fit_report(&self) -> FitReport {
         let model = &self.model;

@@ -65,12 +65,13 @@ impl CarriedBody {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::body::regions::Armhole;
     use glam::DVec3;
 
-    fn body() -> CarriedBody {
+    /// A mannequin's header as tests need one.
+    pub(crate) fn body() -> CarriedBody {
         let armhole = |side: f64| {
             Armhole::through(
                 DVec3::new(side * 150.0, 0.0, 1250.0),

@@ -4,11 +4,15 @@
 //! ```text
 //! file bytes --format--> Mesh --clean--> body Mesh --frame--> canonical body Mesh
 //! ```
+//!
+//! [`prepare`] is the commands' prologue on top of that: the scan loaded, its warnings
+//! gathered and its body denoised.
 
 pub mod carried;
 pub mod clean;
 pub mod format;
 pub mod frame;
+pub mod prepare;
 
 use crate::body::mesh::{Aabb, Mesh};
 use crate::messages;
@@ -16,6 +20,7 @@ use carried::CarriedBody;
 use clean::{CleanError, CleaningReport};
 use format::{Format, MeshFile, ReadError};
 use frame::{CanonicalFrame, FrameError, FrameOptions};
+pub use prepare::{PreparedScan, ScanOptions, prepare};
 use std::path::{Path, PathBuf};
 
 /// A body scan ready for the pipeline.

@@ -1,0 +1,118 @@
+//! The prologue of every command that reads a scan: load it, gather what the reader's cleaning
+//! and the topology check warn about, and denoise it (not a mannequin dressform made, which
+//! has no scanner noise).
+
+use super::frame::FrameOptions;
+use super::{Scan, ScanError, load};
+use crate::body::mesh::topology;
+use std::path::Path;
+
+/// How a command reads and prepares its scan.
+#[derive(Debug, Clone, Default)]
+pub struct ScanOptions {
+    /// The scan's frame, where the user gave it (detected otherwise).
+    pub frame: FrameOptions,
+    /// Taubin smoothing passes ([`crate::body::mesh::Mesh::taubin_smooth`]), 0 for none; never
+    /// applied to a mannequin dressform made ([`Scan::carried`]).
+    pub smooth: usize,
+}
+
+/// A scan read and prepared for a command.
+#[derive(Debug, Clone)]
+pub struct PreparedScan {
+    /// The scan, in the canonical frame, smoothed where [`Self::smoothed`] says.
+    pub scan: Scan,
+    /// What the reader's cleaning found, then what the topology check found (holes,
+    /// manifoldness, orientation): always in that order.
+    pub warnings: Vec<String>,
+    /// Whether the body was smoothed (passes asked for, and not a mannequin dressform made).
+    pub smoothed: bool,
+}
+
+/// Reads the scan at `path` in the frame `options` give, gathers its warnings and smooths
+/// it (see [`PreparedScan::new`]).
+pub fn prepare(path: &Path, options: &ScanOptions) -> Result<PreparedScan, ScanError> {
+    Ok(PreparedScan::new(load(path, &options.frame)?, options.smooth))
+}
+
+impl PreparedScan {
+    /// `scan` (already read) with its warnings gathered (the cleaning's, then the topology's),
+    /// and smoothed with `passes` Taubin passes unless it is a mannequin dressform made: that
+    /// has no scanner noise, and is measured as it is, at the levels its file carries.
+    pub fn new(mut scan: Scan, passes: usize) -> PreparedScan {
+        let mut warnings = scan.cleaning.warnings();
+        warnings.extend(topology(&scan.body).warnings());
+        let smoothed = passes > 0 && scan.carried.is_none();
+        if smoothed {
+            scan.body.taubin_smooth(passes);
+        }
+        PreparedScan { scan, warnings, smoothed }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::body::mesh::Mesh;
+    use crate::body::mesh::shapes::add_tetrahedron;
+    use crate::body::scan::frame::{CanonicalFrame, FileFrame, Units};
+    use glam::DVec3;
+
+    /// `mesh` as a scan, cleaned and in the frame of its own coordinates (mm, Z up).
+    fn scan_of(mesh: Mesh) -> Scan {
+        let identity = FileFrame {
+            units: Units::Mm,
+            rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            translation: [0.0; 3],
+        };
+        super::super::cleaned_and_placed(mesh, Path::new("test.obj"), |body| {
+            Ok(CanonicalFrame::stated(&identity, body).expect("the identity is a frame"))
+        })
+        .expect("a tetrahedron cleans")
+    }
+
+    /// A tetrahedron: closed, smoothing moves its corners.
+    fn tetrahedron() -> Mesh {
+        let mut mesh = Mesh::default();
+        add_tetrahedron(&mut mesh, DVec3::ZERO, 100.0);
+        mesh
+    }
+
+    #[test]
+    fn warnings_come_from_the_reader_first_then_from_the_topology() {
+        let mut mesh = Mesh::default();
+        add_tetrahedron(&mut mesh, DVec3::new(500.0, 0.0, 0.0), 1.0); // an island
+        add_tetrahedron(&mut mesh, DVec3::ZERO, 100.0); // the body
+        mesh.triangles.pop(); // a hole in the body
+        mesh.triangles.push([4, 4, 5]); // degenerate
+        let prepared = PreparedScan::new(scan_of(mesh), 0);
+        let w = &prepared.warnings;
+        assert_eq!(w.len(), 3, "{w:?}");
+        assert!(w[0].contains("degenerate"), "{w:?}");
+        assert!(w[1].contains("connected components"), "{w:?}");
+        assert!(w[2].contains("1 hole"), "{w:?}");
+        assert!(!prepared.smoothed);
+    }
+
+    #[test]
+    fn a_scan_is_smoothed_and_a_mannequin_dressform_made_is_not() {
+        let before = tetrahedron().positions;
+        let scan = PreparedScan::new(scan_of(tetrahedron()), 8);
+        assert!(scan.smoothed && scan.warnings.is_empty(), "{:?}", scan.warnings);
+        assert_ne!(scan.scan.body.positions, before);
+
+        let mut mannequin = scan_of(tetrahedron());
+        mannequin.carried = Some(crate::body::scan::carried::tests::body());
+        let mannequin = PreparedScan::new(mannequin, 8);
+        assert!(!mannequin.smoothed);
+        assert_eq!(mannequin.scan.body.positions, before);
+    }
+
+    #[test]
+    fn no_passes_no_smoothing() {
+        let before = tetrahedron().positions;
+        let scan = PreparedScan::new(scan_of(tetrahedron()), 0);
+        assert!(!scan.smoothed);
+        assert_eq!(scan.scan.body.positions, before);
+    }
+}

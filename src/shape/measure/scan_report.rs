@@ -1,0 +1,68 @@
+//! A scan measured as `dressform measure` reports it: its landmarks and levels (found on it,
+//! or carried by the file of a mannequin dressform made), Table 1's girths, the ISO 8559-1
+//! dimensions, torso girths at heights asked for, and where a number is unreliable.
+
+use super::{
+    BodyDimensions, Girth, Levels, Measurements, contact_warnings, dimensions, find_levels,
+    measure_at, warnings,
+};
+use crate::body::regions::{Landmarks, RegionError};
+use crate::body::scan::Scan;
+use crate::body::segmented_body::SegmentedBody;
+use serde::Serialize;
+
+/// What [`measure_scan`] found (the `measure --json` object, documented in the README).
+#[derive(Debug, Clone, Serialize)]
+pub struct MeasureReport {
+    /// The scan's source, as messages name it.
+    pub file: String,
+    /// Its landmarks.
+    pub landmarks: Landmarks,
+    /// Its chest, waist and hip levels.
+    pub levels: Levels,
+    /// Table 1's measurements at those levels.
+    pub measurements: Measurements,
+    /// The ISO 8559-1 body dimensions.
+    pub dimensions: BodyDimensions,
+    /// Torso girths at the requested heights (`null` where there is no torso).
+    pub at: Vec<Option<Girth>>,
+    /// Where a number is unreliable.
+    pub warnings: Vec<String>,
+}
+
+/// Measures `scan` (canonical frame, smoothed as the caller wants), with the torso girths at
+/// the heights `at` (mm). A mannequin dressform made is measured at the levels and with the
+/// landmarks its file carries; any other body is segmented and its levels found, a level
+/// that fell back to the body's proportions noted among the warnings.
+pub fn measure_scan(scan: &Scan, at: &[f64]) -> Result<MeasureReport, RegionError> {
+    let (body, levels, fallbacks) = match scan.carried {
+        Some(carried) => {
+            (SegmentedBody::armless(&scan.body, carried.landmarks), carried.levels, Vec::new())
+        }
+        None => {
+            let body = SegmentedBody::find(&scan.body)?;
+            let found = find_levels(&body);
+            (body, found.levels, found.fallbacks)
+        }
+    };
+    let measurements = measure_at(&body, &levels);
+    let dimensions = dimensions(&body, &levels);
+    let mut warnings = warnings(&scan.body, &levels);
+    warnings.extend(contact_warnings(body.landmarks(), &levels));
+    warnings.extend(fallbacks);
+    let at = body
+        .torso_sections(at)
+        .into_iter()
+        .zip(at)
+        .map(|(l, &z)| l.map(|c| Girth::of(z, &c)))
+        .collect();
+    Ok(MeasureReport {
+        file: scan.source.display().to_string(),
+        landmarks: *body.landmarks(),
+        levels,
+        measurements,
+        dimensions,
+        at,
+        warnings,
+    })
+}
