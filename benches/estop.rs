@@ -7,7 +7,7 @@
 //! `cargo bench --bench estop` runs 20 tries per link, with no other client on the drive's
 //! control endpoint and with 5 silent clients connected to it (issue 29: the stop within
 //! 50 ms regardless), and prints the median and the largest latency beside criterion's
-//! statistics. Each drive clears the previous e-stop at its start, as the README promises.
+//! statistics. Each drive clears the previous e-stop at its start, as docs/controller-and-safety.md ("Recovery") promises.
 
 use std::os::linux::net::SocketAddrExt;
 use std::os::unix::net::{SocketAddr, UnixStream};

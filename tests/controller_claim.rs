@@ -280,7 +280,7 @@ fn silent_clients_do_not_delay_the_stop() {
         let start = Instant::now();
         let estop = estop(&server, transport, &[]);
         wait_latched(&server);
-        // The latency itself is `cargo bench --bench estop`'s (the README's table); here, far
+        // The latency itself is `cargo bench --bench estop`'s (docs/performance.md#e-stop-latency); here, far
         // below one silent client's read timeout.
         assert!(start.elapsed() < REPLY_TIMEOUT, "{:?}: {}", start.elapsed(), text(&estop));
         assert_eq!(estop.status.code(), Some(0), "{}", text(&estop));

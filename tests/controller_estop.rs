@@ -17,7 +17,7 @@ use crate::controller_pty::start;
 /// How long a drive may take to get moving (discovery and homing take about a second on a
 /// quiet machine).
 const START_TIMEOUT: Duration = Duration::from_secs(30);
-/// How long the nodes may take to latch an e-stop; ~10 ms on a quiet machine (the README
+/// How long the nodes may take to latch an e-stop; ~10 ms on a quiet machine (docs/performance.md
 /// gives the measured latency), this much on a loaded one.
 const LATCH_TIMEOUT: Duration = Duration::from_secs(5);
 

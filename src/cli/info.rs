@@ -9,7 +9,7 @@ use std::path::PathBuf;
 pub struct InfoArgs {
     /// The scan: an .obj, .ply or .stl file.
     scan: PathBuf,
-    /// Print the report as JSON (documented in the README).
+    /// Print the report as JSON (documented in docs/formats.md).
     #[arg(long)]
     json: bool,
     #[command(flatten)]

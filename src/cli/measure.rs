@@ -15,7 +15,7 @@ pub struct MeasureArgs {
     /// Also give the torso girth at these heights (mm above the floor), comma-separated.
     #[arg(long, value_delimiter = ',')]
     at: Vec<f64>,
-    /// Print JSON (documented in the README): an object, or an array for several scans.
+    /// Print JSON (documented in docs/measurements.md): an object, or an array for several scans.
     #[arg(long, conflicts_with = "csv")]
     json: bool,
     /// Print CSV for spreadsheets: a header line, then one row per scan.
@@ -95,7 +95,7 @@ fn print_text(m: &MeasureReport, at: &[f64]) {
     outln!("{}", m.file);
     let g = |name: &str, v: f64| {
         if v.is_nan() {
-            // A fold or landmark the body does not show (see the README's rules).
+            // A fold or landmark the body does not show (docs/measurements.md, "The measurement set").
             outln!("  {name:<22} not measured")
         } else {
             outln!("  {name:<22} {v:7.1} mm")

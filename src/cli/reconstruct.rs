@@ -28,7 +28,7 @@ pub struct ReconstructArgs {
     /// The body model (.glb) [default: the built-in model].
     #[arg(long)]
     model: Option<PathBuf>,
-    /// Joint angles to set on the symmetric pose (TOML; see the README's "Pose symmetry").
+    /// Joint angles to set on the symmetric pose (TOML; see docs/formats.md).
     #[arg(long)]
     pose: Option<PathBuf>,
     #[command(flatten)]

@@ -41,7 +41,7 @@ pub struct RunArgs {
     /// The body model (.glb) [default: the built-in model].
     #[arg(long)]
     model: Option<PathBuf>,
-    /// Joint angles to set on the symmetric pose (TOML; see the README's "Pose symmetry").
+    /// Joint angles to set on the symmetric pose (TOML; see docs/formats.md).
     #[arg(long)]
     pose: Option<PathBuf>,
     #[command(flatten)]

@@ -17,7 +17,7 @@ use signal_hook::low_level::emulate_default_handler;
 /// How long the process may take to end after a signal stopped the form.
 const GRACE: Duration = Duration::from_secs(2);
 
-/// The exit status after a signal stopped the form: the form failed (see the README).
+/// The exit status after a signal stopped the form: the form failed (README.md#exit-status).
 const STOPPED: i32 = 1;
 
 /// The armed links, each with the number of its [`Armed`] guard.

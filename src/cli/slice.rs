@@ -15,7 +15,7 @@ pub struct SliceArgs {
     /// Heights of the cutting planes in mm above the floor (canonical frame), comma-separated.
     #[arg(long, value_delimiter = ',', required = true)]
     heights: Vec<f64>,
-    /// Print JSON (documented in the README).
+    /// Print JSON (documented in docs/measurements.md).
     #[arg(long)]
     json: bool,
     #[command(flatten)]

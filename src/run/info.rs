@@ -8,7 +8,7 @@ use crate::body::scan::frame::{Direction, Units};
 use serde::Serialize;
 use std::fmt;
 
-/// Everything `dressform info` reports (see the README for the JSON layout).
+/// Everything `dressform info` reports (its JSON layout: docs/formats.md, `dressform info --json`).
 #[derive(Debug, Clone, Serialize)]
 pub struct ScanInfo {
     /// The file.

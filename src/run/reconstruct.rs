@@ -275,7 +275,7 @@ pub struct ThreeColumns {
 /// same scan gives the same bytes (the commands print the time).
 #[derive(Debug, Clone, Serialize)]
 pub struct FitReport {
-    /// Per bone: fitted and symmetric rotation vectors (degrees; see `README.md`, pose).
+    /// Per bone: fitted and symmetric rotation vectors (degrees; see docs/formats.md, `fit.json`).
     pub joints: Vec<JointAngles>,
     /// The shape coefficients (standard deviations), the last ones the limb segments' lengths
     /// ([`model_fit::segment_lengths`]).

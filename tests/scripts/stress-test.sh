@@ -4,7 +4,7 @@
 # Real-time tests (ptys, the e-stop, liveness, a stopped simulator) must pass here too. Not
 # part of CI.
 #
-#   tests/scripts/stress-test.sh [runs]             # default 1; the README reports 3 in a row
+#   tests/scripts/stress-test.sh [runs]             # default 1; docs/reliability.md reports 3 in a row
 #   tests/scripts/stress-test.sh [runs] FILTER...   # only the root tests matching a filter,
 #                                                   # e.g. `3 controller` (every real-time case
 #                                                   # of the link: e-stop, claim, liveness, ptys)

@@ -48,8 +48,8 @@ use super::transport::{Gate, StopCause, Transport, TransportError};
 pub const REPLY_TIMEOUT: Duration = Duration::from_secs(1);
 
 /// How long a client waits for the owner's answer before it sends the stop on the link as
-/// well: the owner answers once three frames are written, a few milliseconds (at most 28 ms
-/// measured on a loaded machine, the README's e-stop table); an owner that takes longer is
+/// well: the owner answers once three frames are written, a few milliseconds (at most 24 ms
+/// measured on a loaded machine, docs/performance.md#e-stop-latency); an owner that takes longer is
 /// hung or descheduled, and a stop sent twice does no harm.
 pub const OWNER_ANSWER_WAIT: Duration = Duration::from_millis(250);
 

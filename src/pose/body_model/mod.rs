@@ -147,7 +147,7 @@ impl BodyModel {
 
 impl BodyModel {
     /// The built-in model file: built by `dressform model build` from the MakeHuman assets
-    /// with the default options (see `src/body_model/README.md`).
+    /// with the default options (see `src/pose/body_model/README.md`).
     pub const BUILTIN_GLB: &'static [u8] = include_bytes!("default_model.glb");
 
     /// The built-in model (a test reads it, so it cannot fail at run time).

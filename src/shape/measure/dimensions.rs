@@ -1,5 +1,5 @@
 //! A tailor's measurement set, named as in ISO 8559-1, taken on a [`SegmentedBody`] at its
-//! measurement [`Levels`]: values in, values out, no stage re-deriving the regions. Each rule is stated on its field and in the README, so that a tailor can
+//! measurement [`Levels`]: values in, values out, no stage re-deriving the regions. Each rule is stated on its field and in docs/measurements.md ("The measurement set"), so that a tailor can
 //! check it with a tape; lengths in millimetres, angles in degrees, heights above the floor.
 
 use super::arms::{ArmMeasures, arms};

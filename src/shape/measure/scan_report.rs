@@ -11,7 +11,7 @@ use crate::body::scan::Scan;
 use crate::body::segmented_body::SegmentedBody;
 use serde::Serialize;
 
-/// What [`measure_scan`] found (the `measure --json` object, documented in the README).
+/// What [`measure_scan`] found (the `measure --json` object, documented in docs/measurements.md).
 #[derive(Debug, Clone, Serialize)]
 pub struct MeasureReport {
     /// The scan's source, as messages name it.

@@ -161,7 +161,7 @@ impl<T: Transport> Session<T> {
                 let actuator = e
                     .actuator
                     .and_then(|a| self.form.actuator_at(node, a).map(|spec| spec.id.clone()));
-                // An unknown code is a fault if the node is in Fault (the README's rule).
+                // An unknown code is a fault if the node is in Fault (firmware-protocol/README.md, "Faults and emergency events").
                 let is_fault = !e.code.fault().is_empty()
                     || (e.code != EmergencyCode::NO_ERROR
                         && in_fault
