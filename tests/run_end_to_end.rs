@@ -3,13 +3,13 @@
 //! adapter), and the `dressform` binary opening that device — then the simulated actuators are
 //! checked against the set-points the run wrote.
 
+use capture_sim::{Artifacts, BodyParams, capture, generate};
 use dressform::body::mesh::Mesh;
 use dressform::body::scan::format::Format;
 use dressform::form::setpoints::SetPoints;
 use form_description::reference;
+use form_sim::serve::{ServeConfig, Transport, serve};
 use glam::DVec3;
-use sim::capture::{Artifacts, BodyParams, capture, generate};
-use sim::serve::{ServeConfig, Transport, serve};
 
 pub(crate) fn scan_file(dir: &std::path::Path) -> std::path::PathBuf {
     scan_of(dir, &BodyParams::default())

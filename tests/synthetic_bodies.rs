@@ -5,14 +5,14 @@
 //!   pose and the corners of the allowed ranges; the arms are loops of their own;
 //! - scans: each hole a scanner leaves is one simple boundary loop at its site.
 
+use capture_sim::{
+    Artifacts, BodyParams, GirthLevel, HoleSite, Pose, SyntheticBody, TriangleSurface, capture,
+    generate,
+};
 use dressform::body::mesh::{Mesh, Topology, components, topology};
 use dressform::body::slice::{Contour, Section, sections};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
-use sim::capture::{
-    Artifacts, BodyParams, GirthLevel, HoleSite, Pose, SyntheticBody, TriangleSurface, capture,
-    generate,
-};
 use std::sync::OnceLock;
 
 fn mesh_of(surface: &TriangleSurface) -> Mesh {

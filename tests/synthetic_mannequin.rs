@@ -4,12 +4,12 @@
 
 use crate::common;
 
+use capture_sim::{Artifacts, BodyParams, Pose, capture, generate};
 use common::{largest_mirror_gap, surface_mesh as mesh_of};
 use dressform::body::mesh::topology;
 use dressform::body::scan::{self, frame::FrameOptions};
 use dressform::run::pipeline::symmetrize;
 use dressform::shape::mannequin::MannequinOptions;
-use sim::capture::{Artifacts, BodyParams, Pose, capture, generate};
 use std::path::Path;
 
 #[test]

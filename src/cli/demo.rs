@@ -9,6 +9,7 @@
 use super::drive::{SimArgs, shape_verdict};
 use super::run::{Drive, Prepared, Reconstruct, shape_form};
 use super::{Failure, progress_bar};
+use capture_sim::{Artifacts, BodyParams, GroundTruth, Pose, capture, generate};
 use dressform::atomic_output::OutputSet;
 use dressform::body::mesh::{Mesh, smooth::DEFAULT_PASSES};
 use dressform::body::scan::format::{Export, Format, Placement};
@@ -19,7 +20,6 @@ use dressform::pose::body_model::BodyModel;
 use dressform::run::info::ScanInfo;
 use dressform::run::reconstruct::ReconstructOptions;
 use glam::DVec3;
-use sim::capture::{Artifacts, BodyParams, GroundTruth, Pose, capture, generate};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]

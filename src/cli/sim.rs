@@ -3,7 +3,7 @@
 
 use super::Failure;
 use super::link::FormArg;
-use sim::serve::{ServeConfig, ServeError, Transport, run_until_ctrl_c};
+use form_sim::serve::{ServeConfig, ServeError, Transport, run_until_ctrl_c};
 use std::io::Write;
 use std::path::PathBuf;
 

@@ -31,6 +31,11 @@ pub mod faults;
 pub mod motion;
 pub mod open;
 pub mod session;
+#[cfg(feature = "simulator")]
+pub mod simulated;
+// Without the simulator: its types, and the refusal to start one.
+#[cfg(not(feature = "simulator"))]
+#[path = "no_simulator.rs"]
 pub mod simulated;
 pub mod transport;
 
