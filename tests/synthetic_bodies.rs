@@ -1,5 +1,5 @@
-//! The synthetic customers and scans of `sim`, checked with dressform's own topology and
-//! slicer (`sim` cannot depend on dressform, so these tests live here):
+//! The synthetic customers and scans of `capture-sim`, checked with dressform's own topology and
+//! slicer (`capture-sim` cannot depend on dressform, so these tests live here):
 //! - bodies: one closed, manifold, consistently oriented piece of genus 0 whose tape girths
 //!   at the requested levels match the request, for 20 random parameter sets, the asymmetric
 //!   pose and the corners of the allowed ranges; the arms are loops of their own;

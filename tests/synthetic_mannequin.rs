@@ -1,4 +1,4 @@
-//! Synthetic customers from `sim` through the whole scan-to-mannequin pipeline: an asymmetric
+//! Synthetic customers from `capture-sim` through the whole scan-to-mannequin pipeline: an asymmetric
 //! body comes out mirror-symmetric with its girths, and a scan with scanner artifacts (noise,
 //! holes, metres, Y up, turned) still gives the customer's known measurements.
 

@@ -205,7 +205,7 @@ pub fn mesh_of(body: &capture_sim::SyntheticBody) -> Mesh {
     surface_mesh(&body.surface)
 }
 
-/// A triangle surface of `sim` (a generated body's, or a simulated scan) as a mesh.
+/// A triangle surface of `capture-sim` (a generated body's, or a simulated scan) as a mesh.
 pub fn surface_mesh(surface: &capture_sim::TriangleSurface) -> Mesh {
     Mesh::new(
         surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),

@@ -1,6 +1,6 @@
 //! Writes a synthetic body as an ASCII OBJ so it can be looked at, and prints its ground truth.
 //!
-//! `cargo run --release -p sim --example synthetic_body -- OUT.obj
+//! `cargo run --release -p capture-sim --example synthetic_body -- OUT.obj
 //! [default|asymmetric|SEED|restSEED] [scanner]` — `restSEED` is the random customer SEED with
 //! one arm lowered to rest on the torso (the left for an even seed), as the segmentation tests
 //! pose it; `scanner` applies [`Artifacts::typical_scanner`] (metres, Y up, holes, noise).
