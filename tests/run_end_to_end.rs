@@ -79,6 +79,7 @@ fn run_shapes_the_form_over_slcan() {
 /// A slim customer: the reference form's waist is 695 mm at its smallest; the run drives the
 /// form as close as it goes and exits 3, naming the rings it could not reach and by how much.
 #[test]
+#[cfg(feature = "simulator")] // drives the simulated form
 fn run_on_a_customer_the_form_cannot_reach_exits_3_naming_the_rings() {
     let tmp = tempfile::tempdir().unwrap();
     let slim = BodyParams {
