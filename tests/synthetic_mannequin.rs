@@ -1,6 +1,6 @@
-//! Synthetic customers from `capture-sim` through the whole scan-to-mannequin pipeline: an asymmetric
-//! body comes out mirror-symmetric with its girths, and a scan with scanner artifacts (noise,
-//! holes, metres, Y up, turned) still gives the customer's known measurements.
+//! Synthetic customers from `capture-sim` through the whole scan-to-mannequin pipeline: an
+//! asymmetric body comes out mirror-symmetric with its girths, and a scan with scanner artifacts
+//! (noise, holes, metres, Y up, turned) still gives the customer's known measurements.
 
 use crate::common;
 

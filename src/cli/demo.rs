@@ -1,5 +1,5 @@
 //! `dressform demo [--out DIR] [--seed N]`: the whole system on a built-in synthetic customer —
-//! generate a body with known measurements (`capture-sim`) standing asymmetrically (one arm further out,
+//! generate a body with known measurements (`capture-sim`), asymmetric (one arm further out,
 //! one leg out), scan it with a typical scanner's artifacts (noise, holes, metres, Y up,
 //! turned), encode the scan as PLY and read it back, re-pose it symmetric (the body model
 //! fitted to it), build the symmetric mannequin, fit the reference form and drive the simulated

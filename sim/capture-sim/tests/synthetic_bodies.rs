@@ -1,6 +1,7 @@
 //! Synthetic bodies: generation is deterministic and the landmarks sit where the canonical
 //! frame says. (Their surfaces and girths are checked with dressform's own topology and
-//! slicer in the root crate's `tests/synthetic_bodies.rs`: `capture-sim` does not depend on dressform.)
+//! slicer in the root crate's `tests/synthetic_bodies.rs`: `capture-sim` does not depend on
+//! dressform.)
 
 use capture_sim::{BodyParams, generate};
 

@@ -1,5 +1,5 @@
-//! The controller on the in-process simulated form (`form_sim::robot` on a `form_sim::bus::can` bus):
-//! try a set-point file without hardware, or chain mannequin → set-points → drive in tests
+//! The controller on the in-process simulated form (`form_sim::robot` on a `form_sim::bus::can`
+//! bus): try a set-point file without hardware, or chain mannequin → set-points → drive in tests
 //! and demos.
 //!
 //! A [`SimulatedRig`] is the form and its bus, living as long as the caller keeps it (one
