@@ -19,7 +19,7 @@ use firmware_protocol::Link;
 use firmware_protocol::message::Sync;
 use firmware_protocol::update::packets;
 use form_description::{FormDescription, reference};
-use sim::bus::can::{CanBus, CanKind};
+use form_sim::bus::can::{CanBus, CanKind};
 
 fn setpoints(form: &FormDescription) -> SetPoints {
     let positions: BTreeMap<String, f64> = form

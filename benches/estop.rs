@@ -19,7 +19,7 @@ use dressform::form::controller::LinkSpec;
 use dressform::form::controller::control::socket_name;
 use firmware_protocol::drive::Faults;
 use form_description::reference;
-use sim::serve::{ServeConfig, Server, Transport, serve};
+use form_sim::serve::{ServeConfig, Server, Transport, serve};
 
 /// Tries per link.
 const TRIES: usize = 20;

@@ -133,10 +133,10 @@ fn benches(c: &mut Criterion) {
 /// (about 300k triangles), standing with the left arm 15 degrees and the right leg 5 degrees
 /// further out, captured with a typical scanner's noise and holes and written as binary PLY.
 fn reconstruct_benches(c: &mut Criterion) {
+    use capture_sim::{Artifacts, BodyParams, capture, generate};
     use dressform::pose::body_model::BodyModel;
     use dressform::pose::model_fit::{self, FitOptions, ScanPoints};
     use dressform::run::reconstruct::{ReconstructOptions, reconstruct};
-    use sim::capture::{Artifacts, BodyParams, capture, generate};
     let mut params = BodyParams::default();
     params.pose.left_arm.abduction_deg += 15.0;
     params.pose.right_leg.abduction_deg += 5.0;

@@ -554,6 +554,7 @@ fn huge_numbers_in_files_are_shown_short() {
 /// Issue 29: the exit-3 summary of a form that could not take the shape was cut mid-number
 /// ("(6... (26 more characters)"); it lists the rings furthest off and ends "and N more".
 #[test]
+#[cfg(feature = "simulator")] // drives the simulated form
 fn a_long_shape_summary_ends_with_how_many_more() {
     let dir = tempfile::tempdir().unwrap();
     let file = write(dir.path(), "setpoints.json", girths_only(5000.0));
@@ -571,6 +572,7 @@ fn a_long_shape_summary_ends_with_how_many_more() {
 /// 18446744073709551615 ms"); a factor too large for the move is bad input (exit 2), and
 /// the message gives the allowed range, from the longest SYNC (65535 ms).
 #[test]
+#[cfg(feature = "simulator")] // drives the simulated form
 fn slower_than_a_sync_can_carry_is_refused_with_the_range() {
     let dir = tempfile::tempdir().unwrap();
     let chest = serde_json::json!({

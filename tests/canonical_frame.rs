@@ -119,7 +119,7 @@ fn overrides_win_over_detection() {
 
 /// The generator's default customer written as a millimetre, Z-up PLY.
 fn millimetre_z_up_scan(dir: &Path) -> std::path::PathBuf {
-    let body = sim::capture::generate(&sim::capture::BodyParams::default()).unwrap();
+    let body = capture_sim::generate(&capture_sim::BodyParams::default()).unwrap();
     let mesh = common::mesh_of(&body);
     let path = dir.join("customer_mm_z_up.ply");
     write_atomically(&path, &Format::Ply.encode(&mesh)).unwrap();

@@ -1,5 +1,5 @@
 //! An e-stop pressed while a command computes is never undone by it (issue 29), on real
-//! pseudo-terminals: the simulated reference form served by `sim::serve` with its candump log,
+//! pseudo-terminals: the simulated reference form served by `form_sim::serve` with its candump log,
 //! `dressform run` claiming it before the body model's fit, and the stop coming from
 //! `dressform estop` in another process (through the control endpoint) or latched on the
 //! nodes directly. The log must show no motion command after the first `EmergencyStop`; the
@@ -19,7 +19,7 @@ use embedded_can::{Frame as _, StandardId};
 use firmware_protocol::drive::{DriveCommand, Faults};
 use firmware_protocol::{Message, Packet, can};
 use form_description::reference;
-use sim::serve::{ServeConfig, Server, Transport, serve};
+use form_sim::serve::{ServeConfig, Server, Transport, serve};
 
 use crate::controller_estop::{flag, text};
 use crate::run_end_to_end::scan_file;

@@ -1,6 +1,9 @@
 //! `dressform drive --sim`, `status --sim` and `estop` from the command line (real time, a
 //! few seconds: homing, then short moves).
 
+// Drives the simulated form (the `simulator` feature).
+#![cfg(feature = "simulator")]
+
 use std::process::Command;
 
 fn dressform(args: &[&str]) -> std::process::Output {
@@ -20,7 +23,7 @@ fn setpoints(dir: &tempfile::TempDir, positions: &str) -> String {
 fn drive_on_the_simulated_form_reports_every_actuator() {
     let dir = tempfile::tempdir().unwrap();
     let file = setpoints(&dir, r#""chest-l1": 3.5, "neck-front": 2.0"#);
-    let form = concat!(env!("CARGO_MANIFEST_DIR"), "/sim/form-description/forms/reference.toml");
+    let form = concat!(env!("CARGO_MANIFEST_DIR"), "/form-description/forms/reference.toml");
     let out = dressform(&["drive", &file, "--form", form, "--sim", "--json"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));

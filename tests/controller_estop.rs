@@ -1,5 +1,5 @@
 //! The e-stop and recovery as a studio uses them, on real pseudo-terminals: the simulated
-//! reference form served by `sim::serve` (serial mapping, or slcan as behind a USB-CAN
+//! reference form served by `form_sim::serve` (serial mapping, or slcan as behind a USB-CAN
 //! adapter), `dressform drive` moving it in one process, and `dressform estop` from another,
 //! a SIGTERM, `dressform reset`, a jammed actuator. Real time: each case takes a few seconds;
 //! waits are generous, for a loaded machine.
@@ -9,8 +9,8 @@ use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use firmware_protocol::drive::{DriveState, Faults};
-use sim::node::ActuatorFault;
-use sim::serve::{Server, Transport};
+use form_sim::node::ActuatorFault;
+use form_sim::serve::{Server, Transport};
 
 use crate::controller_pty::start;
 

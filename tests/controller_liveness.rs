@@ -12,6 +12,9 @@
 //!   a fault afterwards) and for 2.5 s (the drive fails: the link stalled). Tries per case and
 //!   link: `DRESSFORM_STALL_TRIES` (default 2; `tests/scripts/stress-test.sh` sets 20).
 
+// Drives the simulated form (the `simulator` feature).
+#![cfg(feature = "simulator")]
+
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader};
 use std::path::PathBuf;
@@ -27,10 +30,10 @@ use dressform::form::controller::{Connection, DriveError, DriveOptions, LinkSpec
 use dressform::form::setpoints::SetPoints;
 use firmware_protocol::drive::{DriveState, Faults};
 use form_description::reference;
-use sim::bus::can::{CanBus, CanKind};
-use sim::fault::FaultSpec;
-use sim::robot::{FormState, SimOptions, SimulatedForm};
-use sim::serve::{ServeConfig, Transport as Served, serve};
+use form_sim::bus::can::{CanBus, CanKind};
+use form_sim::fault::FaultSpec;
+use form_sim::robot::{FormState, SimOptions, SimulatedForm};
+use form_sim::serve::{ServeConfig, Transport as Served, serve};
 use tokio::time::Instant;
 
 /// The reference form on an in-process classic CAN bus with `faults`, a session with it

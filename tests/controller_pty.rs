@@ -1,5 +1,5 @@
 //! The controller on real pseudo-terminals, as on hardware: the simulated reference form is
-//! served by `sim::serve` (as `dressform sim` does) with the serial mapping or behind an slcan
+//! served by `form_sim::serve` (as `dressform sim` does) with the serial mapping or behind an slcan
 //! adapter, and the host opens the pty's path with `serialport` (real time, a few seconds).
 
 use std::collections::BTreeMap;
@@ -13,7 +13,7 @@ use dressform::form::setpoints::SetPoints;
 use firmware_protocol::NodeId;
 use firmware_protocol::drive::{DriveCommand, Faults};
 use form_description::reference;
-use sim::serve::{ServeConfig, Server, Transport as Served, serve};
+use form_sim::serve::{ServeConfig, Server, Transport as Served, serve};
 use tokio::runtime::Runtime;
 use tokio::time::{Duration, Instant};
 

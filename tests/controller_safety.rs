@@ -4,6 +4,9 @@
 //! strokes, `--clamp` on or off, slower moves, lossy buses and node reboots (which make the
 //! host retry and resume), and checks every packet the host's transport sends.
 
+// Drives the simulated form (the `simulator` feature).
+#![cfg(feature = "simulator")]
+
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
@@ -12,10 +15,10 @@ use dressform::form::controller::{DriveOptions, Gate, Transport, TransportError,
 use dressform::form::setpoints::SetPoints;
 use firmware_protocol::{Address, Link, Message, Packet};
 use form_description::{FormDescription, reference};
+use form_sim::bus::can::{CanBus, CanKind};
+use form_sim::fault::FaultSpec;
+use form_sim::robot::{SimOptions, SimulatedForm};
 use proptest::prelude::*;
-use sim::bus::can::{CanBus, CanKind};
-use sim::fault::FaultSpec;
-use sim::robot::{SimOptions, SimulatedForm};
 
 /// The simulated bus, keeping a copy of everything the host sends.
 struct Recording {

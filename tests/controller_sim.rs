@@ -3,6 +3,9 @@
 //! classic CAN and CAN FD, lossy buses, reboots, silent nodes, faults, emergency stops and
 //! discovery errors.
 
+// Drives the simulated form (the `simulator` feature).
+#![cfg(feature = "simulator")]
+
 use std::collections::BTreeMap;
 use std::time::Duration;
 
@@ -15,9 +18,9 @@ use dressform::form::controller::{
 use dressform::form::setpoints::SetPoints;
 use firmware_protocol::drive::{DriveState, Faults};
 use form_description::{FormDescription, reference};
-use sim::bus::can::{CanBus, CanKind};
-use sim::fault::FaultSpec;
-use sim::robot::{SimOptions, SimulatedForm};
+use form_sim::bus::can::{CanBus, CanKind};
+use form_sim::fault::FaultSpec;
+use form_sim::robot::{SimOptions, SimulatedForm};
 use tokio::time::Instant;
 
 /// Every actuator of the reference form somewhere in its stroke (a different place each).

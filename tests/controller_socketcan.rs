@@ -16,6 +16,9 @@
 //! skips, or fails with `DRESSFORM_REQUIRE_PEERS=1`. Every outcome after that is checked: a
 //! frame that does not arrive, or arrives changed, either way, fails the test.
 
+// Needs the SocketCAN transport (the `socketcan` feature).
+#![cfg(feature = "socketcan")]
+
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 use std::process::{Command, Stdio};

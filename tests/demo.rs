@@ -1,6 +1,9 @@
 //! `dressform demo`: the built-in customer, standing asymmetrically, through the whole system
 //! (pose symmetry included), with outputs.
 
+// Drives the simulated form (the `simulator` feature).
+#![cfg(feature = "simulator")]
+
 use crate::common;
 
 #[test]
@@ -69,7 +72,7 @@ fn setpoints_from_profiles_and_their_errors() {
     // drives the form as close as it goes, writes everything, and says so with status 3.
     assert_eq!(code, 3, "another customer: {stderr}");
     assert!(stderr.contains("could not take the shape") && stderr.contains("waist not reached"));
-    let form = concat!(env!("CARGO_MANIFEST_DIR"), "/sim/form-description/forms/reference.toml");
+    let form = concat!(env!("CARGO_MANIFEST_DIR"), "/form-description/forms/reference.toml");
     let profiles = dir.join("profiles.json");
     let target = out.path().join("again.json");
     let (code, stdout, stderr) = common::dressform(&[

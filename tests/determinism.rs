@@ -5,8 +5,8 @@
 //! `fit.json` holds no wall time.
 
 use crate::common::{output_files, surface_mesh};
+use capture_sim::{Artifacts, BodyParams, capture, generate};
 use dressform::body::scan::format::Format;
-use sim::capture::{Artifacts, BodyParams, capture, generate};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 

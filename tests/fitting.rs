@@ -2,6 +2,7 @@
 //! matches the mannequin's within 2 mm with identical left/right set-points; beyond it, the
 //! saturated rings and their excess are reported and no set-point leaves its stroke.
 
+use capture_sim::{BodyParams, generate};
 use dressform::body::mesh::Mesh;
 use dressform::body::scan::{self, frame::FrameOptions};
 use dressform::form::form_fit::fit;
@@ -10,7 +11,6 @@ use dressform::shape::mannequin::MannequinOptions;
 use dressform::shape::profiles::Profiles;
 use form_description::reference;
 use glam::DVec3;
-use sim::capture::{BodyParams, generate};
 use std::path::Path;
 
 fn profiles_of(params: &BodyParams) -> Profiles {
@@ -83,10 +83,10 @@ fn a_customer_beyond_the_forms_range_is_reported_and_clamped() {
         height_mm: 1800.0,
         leg_length_mm: 820.0,
         shoulder_width_mm: 440.0,
-        pose: sim::capture::Pose {
+        pose: capture_sim::Pose {
             left_arm: arm(70.0),
             right_arm: arm(70.0),
-            ..sim::capture::Pose::a_pose()
+            ..capture_sim::Pose::a_pose()
         },
         ..BodyParams::default()
     };
@@ -104,6 +104,6 @@ fn a_customer_beyond_the_forms_range_is_reported_and_clamped() {
     assert!(hip.saturated.iter().any(|s| s.beyond_mm > 0.0), "{:?}", hip.saturated);
 }
 
-fn arm(abduction: f64) -> sim::capture::ArmPose {
-    sim::capture::ArmPose { abduction_deg: abduction, ..sim::capture::Pose::a_pose().left_arm }
+fn arm(abduction: f64) -> capture_sim::ArmPose {
+    capture_sim::ArmPose { abduction_deg: abduction, ..capture_sim::Pose::a_pose().left_arm }
 }

@@ -18,6 +18,7 @@ mod controller_sim;
 mod controller_socketcan;
 mod demo;
 mod determinism;
+mod features;
 mod fitting;
 mod formats;
 mod fuzz_readers;

@@ -8,6 +8,7 @@
 
 use crate::common;
 
+use capture_sim::{Artifacts, BodyParams, Pose, SyntheticBody, capture, generate};
 use common::quality::{
     PlateRim, creases, edge_creases, largest_crease, near_horizontal_area, plate_rim,
     self_intersecting_pairs, silhouette_top, width_jump,
@@ -25,7 +26,6 @@ use dressform::run::reconstruct::{ReconstructOptions, reconstruct};
 use dressform::shape::mannequin::{Layer, Mannequin, MannequinOptions};
 use glam::DVec3;
 use rayon::prelude::*;
-use sim::capture::{Artifacts, BodyParams, Pose, SyntheticBody, capture, generate};
 use std::path::Path;
 
 /// A body to test: its name, the scan, and for the generator's bodies in an A-pose the two

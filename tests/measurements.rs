@@ -9,6 +9,7 @@
 
 use crate::common;
 
+use capture_sim::{BodyParams, SyntheticBody, generate};
 use common::{dressform, mesh_of};
 use dressform::atomic_output::write_atomically;
 use dressform::body::regions::Landmarks;
@@ -21,7 +22,6 @@ use dressform::shape::measure::{
 };
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
-use sim::capture::{BodyParams, SyntheticBody, generate};
 
 /// Girths against the generator's (mm): ISO 20685-1 allows 4 mm for small girths; the mesh
 /// (a 4 mm grid) reads a tape girth within about 1 mm.

@@ -467,7 +467,7 @@ fn remesher() -> Result<String, String> {
 /// waist and hip (at the A-pose body's levels) within 5 mm.
 #[test]
 fn reconstruct_straightens_the_sim_generators_asymmetric_bodies() {
-    use sim::capture::{Artifacts, BodyParams, Pose as SimPose, capture, generate};
+    use capture_sim::{Artifacts, BodyParams, Pose as SimPose, capture, generate};
     let model = BodyModel::builtin();
     let tmp = tempfile::tempdir().unwrap();
     let scanned = |params: &BodyParams, name: &str| {

@@ -108,7 +108,7 @@ fn row(name: &str, p: &Proportions) -> String {
 
 #[test]
 fn the_generators_arms_and_the_models_are_measured_alike() {
-    use sim::capture::{BodyParams, generate};
+    use capture_sim::{BodyParams, generate};
     let model = BodyModel::builtin();
     let mut rows = vec![format!(
         "{:<30} {:>8} {:>9} {:>8} {:>6} {:>9} {:>9}",

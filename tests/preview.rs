@@ -4,8 +4,8 @@
 
 use crate::common;
 
+use capture_sim::{BodyParams, generate};
 use dressform::body::scan::format::Format;
-use sim::capture::{BodyParams, generate};
 
 /// The level lines' colours in the preview (chest, waist, hip), as documented in
 /// `src/preview/mod.rs`, and how far a pixel may be from one to count (anti-aliasing).

@@ -3,13 +3,13 @@
 //! adapter), and the `dressform` binary opening that device — then the simulated actuators are
 //! checked against the set-points the run wrote.
 
+use capture_sim::{Artifacts, BodyParams, capture, generate};
 use dressform::body::mesh::Mesh;
 use dressform::body::scan::format::Format;
 use dressform::form::setpoints::SetPoints;
 use form_description::reference;
+use form_sim::serve::{ServeConfig, Transport, serve};
 use glam::DVec3;
-use sim::capture::{Artifacts, BodyParams, capture, generate};
-use sim::serve::{ServeConfig, Transport, serve};
 
 pub(crate) fn scan_file(dir: &std::path::Path) -> std::path::PathBuf {
     scan_of(dir, &BodyParams::default())
@@ -79,6 +79,7 @@ fn run_shapes_the_form_over_slcan() {
 /// A slim customer: the reference form's waist is 695 mm at its smallest; the run drives the
 /// form as close as it goes and exits 3, naming the rings it could not reach and by how much.
 #[test]
+#[cfg(feature = "simulator")] // drives the simulated form
 fn run_on_a_customer_the_form_cannot_reach_exits_3_naming_the_rings() {
     let tmp = tempfile::tempdir().unwrap();
     let slim = BodyParams {

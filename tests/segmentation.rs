@@ -4,12 +4,12 @@
 
 use crate::common;
 
+use capture_sim::{BodyParams, Pose, generate};
 use common::{makehuman, mesh_of};
 use dressform::body::regions::Armhole;
 use dressform::body::scan::{self, frame::FrameOptions};
 use dressform::body::segmented_body::SegmentedBody;
 use glam::DVec3;
-use sim::capture::{BodyParams, Pose, generate};
 
 /// Spacing of the torso sections compared for the width jump (the mannequin's own rule).
 const JUMP_STEP_MM: f64 = 2.0;

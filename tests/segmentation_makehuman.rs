@@ -8,6 +8,7 @@
 //! case is printed.
 
 use crate::common::{self, uniform};
+use capture_sim::{TriangleSurface, with_noise_and_holes};
 use dressform::body::mesh::Mesh;
 use dressform::body::regions::Landmarks;
 use dressform::body::scan::{self, Scan};
@@ -18,7 +19,6 @@ use dressform::shape::mannequin::MannequinOptions;
 use dressform::shape::measure::{Measurements, levels, measure_at};
 use glam::DVec3;
 use rayon::prelude::*;
-use sim::capture::{TriangleSurface, with_noise_and_holes};
 use std::path::Path;
 use std::sync::OnceLock;
 

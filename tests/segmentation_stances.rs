@@ -10,22 +10,22 @@
 //! (15 mm for an arm held out horizontally). The worst case of each stance is printed.
 
 use crate::common::{mesh_of, uniform};
+use capture_sim::{BodyParams, generate};
 use dressform::body::regions::Armhole;
 use dressform::body::segmented_body::SegmentedBody;
 use dressform::shape::measure::{levels, measure_at};
 use glam::DVec3;
 use rayon::prelude::*;
-use sim::capture::{BodyParams, generate};
 
 /// Bodies per stance.
 const BODIES: u64 = 20;
 /// The largest girth error allowed against the truth (mm).
 const GIRTH_TOLERANCE_MM: f64 = 2.0;
 /// How far outside the armless body a torso point may lie below the armpits (mm): the
-/// generator's surface is a chain of smooth minima (`sim::capture::primitives::smooth_min`),
+/// generator's surface is a chain of smooth minima (`capture_sim::primitives::smooth_min`),
 /// each of which pulls the surface out by at most a quarter of its width; near the armpit
 /// three arm parts blend into the torso one after the other (`arm_parts` in
-/// `sim/src/capture/body.rs`: trapezius 25 mm, deltoid 18 mm, upper arm 18 mm), so the
+/// `sim/capture-sim/src/body.rs`: trapezius 25 mm, deltoid 18 mm, upper arm 18 mm), so the
 /// torso's own surface there may lie up to (25 + 18 + 18) / 4 mm outside the body without its
 /// arms. Arm material itself lies an arm's radius (40 mm or more) out.
 const BLEND_MM: f64 = (25.0 + 18.0 + 18.0) / 4.0;
@@ -143,7 +143,7 @@ fn check(stance: Stance, seed: u64) -> Result<Outcome, String> {
 
     // Arm material: torso sections every 10 mm from the crotch to the neck.
     let lm = segmented.landmarks();
-    let truth_plate = |s: &sim::capture::SideLandmarks, side: f64| {
+    let truth_plate = |s: &capture_sim::SideLandmarks, side: f64| {
         Armhole::through(
             DVec3::from_array(s.armpit),
             DVec3::from_array(s.acromion),

@@ -1,18 +1,18 @@
-//! The synthetic customers and scans of `sim`, checked with dressform's own topology and
-//! slicer (`sim` cannot depend on dressform, so these tests live here):
+//! The synthetic customers and scans of `capture-sim`, checked with dressform's own topology and
+//! slicer (`capture-sim` cannot depend on dressform, so these tests live here):
 //! - bodies: one closed, manifold, consistently oriented piece of genus 0 whose tape girths
 //!   at the requested levels match the request, for 20 random parameter sets, the asymmetric
 //!   pose and the corners of the allowed ranges; the arms are loops of their own;
 //! - scans: each hole a scanner leaves is one simple boundary loop at its site.
 
+use capture_sim::{
+    Artifacts, BodyParams, GirthLevel, HoleSite, Pose, SyntheticBody, TriangleSurface, capture,
+    generate,
+};
 use dressform::body::mesh::{Mesh, Topology, components, topology};
 use dressform::body::slice::{Contour, Section, sections};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
-use sim::capture::{
-    Artifacts, BodyParams, GirthLevel, HoleSite, Pose, SyntheticBody, TriangleSurface, capture,
-    generate,
-};
 use std::sync::OnceLock;
 
 fn mesh_of(surface: &TriangleSurface) -> Mesh {

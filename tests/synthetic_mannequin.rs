@@ -1,15 +1,15 @@
-//! Synthetic customers from `sim` through the whole scan-to-mannequin pipeline: an asymmetric
-//! body comes out mirror-symmetric with its girths, and a scan with scanner artifacts (noise,
-//! holes, metres, Y up, turned) still gives the customer's known measurements.
+//! Synthetic customers from `capture-sim` through the whole scan-to-mannequin pipeline: an
+//! asymmetric body comes out mirror-symmetric with its girths, and a scan with scanner artifacts
+//! (noise, holes, metres, Y up, turned) still gives the customer's known measurements.
 
 use crate::common;
 
+use capture_sim::{Artifacts, BodyParams, Pose, capture, generate};
 use common::{largest_mirror_gap, surface_mesh as mesh_of};
 use dressform::body::mesh::topology;
 use dressform::body::scan::{self, frame::FrameOptions};
 use dressform::run::pipeline::symmetrize;
 use dressform::shape::mannequin::MannequinOptions;
-use sim::capture::{Artifacts, BodyParams, Pose, capture, generate};
 use std::path::Path;
 
 #[test]

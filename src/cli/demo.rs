@@ -1,5 +1,5 @@
 //! `dressform demo [--out DIR] [--seed N]`: the whole system on a built-in synthetic customer —
-//! generate a body with known measurements (`sim`) standing asymmetrically (one arm further out,
+//! generate a body with known measurements (`capture-sim`), asymmetric (one arm further out,
 //! one leg out), scan it with a typical scanner's artifacts (noise, holes, metres, Y up,
 //! turned), encode the scan as PLY and read it back, re-pose it symmetric (the body model
 //! fitted to it), build the symmetric mannequin, fit the reference form and drive the simulated
@@ -9,6 +9,7 @@
 use super::drive::{SimArgs, shape_verdict};
 use super::run::{Drive, Prepared, Reconstruct, shape_form};
 use super::{Failure, progress_bar};
+use capture_sim::{Artifacts, BodyParams, GroundTruth, Pose, capture, generate};
 use dressform::atomic_output::OutputSet;
 use dressform::body::mesh::{Mesh, smooth::DEFAULT_PASSES};
 use dressform::body::scan::format::{Export, Format, Placement};
@@ -19,7 +20,6 @@ use dressform::pose::body_model::BodyModel;
 use dressform::run::info::ScanInfo;
 use dressform::run::reconstruct::{MeasurementsReport, ReconstructOptions};
 use glam::DVec3;
-use sim::capture::{Artifacts, BodyParams, GroundTruth, Pose, capture, generate};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]

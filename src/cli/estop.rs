@@ -11,14 +11,9 @@
 //! [`shared_stop_gate`]). A stop is never refused.
 
 use super::Failure;
-use super::link::{self, FormArg, LinkArgs, runtime};
-use dressform::form::controller::open::OpenLink;
-use dressform::form::controller::simulated::SimConfig;
+use super::link::{self, FormArg, LinkArgs};
 use dressform::form::controller::transport::shared_stop_gate;
-use dressform::form::controller::{
-    Connection, LinkSpec, StopCause, control, emergency_stop, fault_names,
-};
-use std::time::Duration;
+use dressform::form::controller::{Connection, StopCause, control, emergency_stop};
 
 #[derive(Debug, clap::Args)]
 pub struct EstopArgs {
@@ -29,14 +24,12 @@ pub struct EstopArgs {
     form: FormArg,
 }
 
-/// How long the simulated form may take to latch the stop before its nodes are shown
-/// (a few ms; more on a busy machine).
-const SETTLE: Duration = Duration::from_secs(2);
-
 pub fn run(args: &EstopArgs) -> Result<(), Failure> {
     let spec = args.link.spec();
-    if spec == LinkSpec::Sim {
-        return on_sim(args);
+    link::built(&spec)?;
+    #[cfg(feature = "simulator")]
+    if spec == dressform::form::controller::LinkSpec::Sim {
+        return on_sim::run(args);
     }
     match control::request_estop(&spec) {
         Ok(Some(owner)) if owner.trusted() => {
@@ -76,28 +69,42 @@ pub fn run(args: &EstopArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// A simulated form started for this command (opened as every command opens `--sim`):
-/// stopped, then every node shown.
-fn on_sim(args: &EstopArgs) -> Result<(), Failure> {
-    let form = args.form.load()?;
-    let truth = runtime()?.block_on(async {
-        let OpenLink { connection, rig } =
-            link::open(&LinkSpec::Sim, &form, &SimConfig::default())?;
-        let rig = rig.ok_or_else(|| Failure::other("the simulated form did not start"))?;
-        emergency_stop(&connection).map_err(Failure::other)?;
-        // The host's side closes before the simulated form stops (as `OpenLink` drops them).
-        drop(connection);
-        let deadline = tokio::time::Instant::now() + SETTLE;
-        let latched = || rig.truth().nodes.iter().all(|n| !n.faults.is_empty());
-        while !latched() && tokio::time::Instant::now() < deadline {
-            tokio::time::sleep(Duration::from_millis(1)).await;
+/// `estop --sim`: a simulated form started for this command (opened as every command opens
+/// `--sim`): stopped, then every node shown.
+#[cfg(feature = "simulator")]
+mod on_sim {
+    use super::{EstopArgs, Failure, link};
+    use crate::cli::link::runtime;
+    use dressform::form::controller::open::OpenLink;
+    use dressform::form::controller::simulated::SimConfig;
+    use dressform::form::controller::{LinkSpec, emergency_stop, fault_names};
+    use std::time::Duration;
+
+    /// How long the simulated form may take to latch the stop before its nodes are shown
+    /// (a few ms; more on a busy machine).
+    const SETTLE: Duration = Duration::from_secs(2);
+
+    pub fn run(args: &EstopArgs) -> Result<(), Failure> {
+        let form = args.form.load()?;
+        let truth = runtime()?.block_on(async {
+            let OpenLink { connection, rig } =
+                link::open(&LinkSpec::Sim, &form, &SimConfig::default())?;
+            let rig = rig.ok_or_else(|| Failure::other("the simulated form did not start"))?;
+            emergency_stop(&connection).map_err(Failure::other)?;
+            // The host's side closes before the simulated form stops (as `OpenLink` drops them).
+            drop(connection);
+            let deadline = tokio::time::Instant::now() + SETTLE;
+            let latched = || rig.truth().nodes.iter().all(|n| !n.faults.is_empty());
+            while !latched() && tokio::time::Instant::now() < deadline {
+                tokio::time::sleep(Duration::from_millis(1)).await;
+            }
+            Ok::<_, Failure>(rig.truth())
+        })?;
+        outln!("a simulated form started for this command (it ends with it):");
+        for node in &truth.nodes {
+            outln!("node {}: {}", node.node.get(), fault_names(node.faults).join("|"));
         }
-        Ok::<_, Failure>(rig.truth())
-    })?;
-    outln!("a simulated form started for this command (it ends with it):");
-    for node in &truth.nodes {
-        outln!("node {}: {}", node.node.get(), fault_names(node.faults).join("|"));
+        errln!("emergency stop sent");
+        Ok(())
     }
-    errln!("emergency stop sent");
-    Ok(())
 }

@@ -90,6 +90,7 @@ pub struct Owned {
 /// (with `--sim`, starts the simulated `form` as `sim` says) and arms the endpoint and the
 /// signals with its gate. Must be called within a tokio runtime.
 pub fn own(spec: &LinkSpec, form: &FormDescription, sim: &SimConfig) -> Result<Owned, Failure> {
+    built(spec)?;
     let endpoint = Endpoint::bind(spec).map_err(Failure::other)?;
     let OpenLink { connection, rig } = open(spec, form, sim)?;
     if let Some(endpoint) = &endpoint {
@@ -102,6 +103,7 @@ pub fn own(spec: &LinkSpec, form: &FormDescription, sim: &SimConfig) -> Result<O
 /// Opens the link `spec` names ([`OpenLink::open`]: with `--sim`, starts the simulated `form`
 /// as `sim` says), without owning it. Must be called within a tokio runtime.
 pub fn open(spec: &LinkSpec, form: &FormDescription, sim: &SimConfig) -> Result<OpenLink, Failure> {
+    built(spec)?;
     OpenLink::open(spec, form, sim).map_err(|e| match e {
         OpenError::Hardware(e) => Failure::other(e),
         OpenError::Sim(e) => sim_failure(e),
@@ -112,8 +114,36 @@ pub fn open(spec: &LinkSpec, form: &FormDescription, sim: &SimConfig) -> Result<
 /// input (2), its log failed (1), the drive failed as drives do.
 pub fn sim_failure(e: SimDriveError) -> Failure {
     match e {
+        #[cfg(feature = "simulator")]
         SimDriveError::Sim(_) => Failure::bad_input(e),
+        #[cfg(feature = "simulator")]
         SimDriveError::Log { .. } => Failure::other(e),
+        #[cfg(feature = "simulator")]
         SimDriveError::Drive(d) => d.into(),
+        #[cfg(not(feature = "simulator"))]
+        SimDriveError::NotBuilt => Failure::bad_input(e),
+    }
+}
+
+/// The simulator, as a refusal names what this dressform lacks.
+pub const SIMULATOR: &str = "the simulator (cargo feature `simulator`)";
+/// SocketCAN, as a refusal names what this dressform lacks.
+pub const SOCKETCAN: &str = "SocketCAN (cargo feature `socketcan`)";
+
+/// `what` (`--sim`, `dressform demo`) in a dressform built without `missing` ([`SIMULATOR`],
+/// [`SOCKETCAN`]): a one-line refusal, exit status 2.
+pub fn not_built(what: &str, missing: &str) -> Failure {
+    Failure::bad_input(format!(
+        "{what}: this dressform was built without {missing}; rebuild with default features"
+    ))
+}
+
+/// Refuses a link this dressform was built without (`--sim`, `--can`), before anything is
+/// opened.
+pub fn built(spec: &LinkSpec) -> Result<(), Failure> {
+    match spec {
+        LinkSpec::Sim if cfg!(not(feature = "simulator")) => Err(not_built("--sim", SIMULATOR)),
+        LinkSpec::Can(_) if cfg!(not(feature = "socketcan")) => Err(not_built("--can", SOCKETCAN)),
+        _ => Ok(()),
     }
 }

@@ -25,6 +25,7 @@ macro_rules! errln {
     };
 }
 
+#[cfg(feature = "simulator")]
 mod demo;
 mod drive;
 mod estop;
@@ -38,10 +39,17 @@ mod reset;
 mod run;
 mod setpoints;
 mod signals;
+#[cfg(feature = "simulator")]
 mod sim;
 mod slice;
 mod status;
 mod symmetrize;
+
+// Without the simulator: `demo` and `sim` still parse, and refuse.
+#[cfg(not(feature = "simulator"))]
+mod no_simulator;
+#[cfg(not(feature = "simulator"))]
+use no_simulator::{demo, sim};
 
 use clap::builder::{PossibleValue, PossibleValuesParser, RangedU64ValueParser, TypedValueParser};
 use clap::{Parser, Subcommand};

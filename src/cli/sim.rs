@@ -3,7 +3,7 @@
 
 use super::Failure;
 use super::link::FormArg;
-use sim::serve::{ServeConfig, ServeError, Transport, run_until_ctrl_c};
+use form_sim::serve::{ServeConfig, ServeError, Transport, run_until_ctrl_c};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -22,7 +22,7 @@ pub struct ServeArgs {
     #[arg(long)]
     log: Option<PathBuf>,
     /// Faults to inject, e.g. `drop=0.05,corrupt=0.01,node3:reboot@1.5s,chest-l1:stall@2s`
-    /// (grammar in sim/README.md).
+    /// (grammar in sim/form-sim/README.md).
     #[arg(long)]
     faults: Option<String>,
 }

@@ -7,7 +7,9 @@ pub mod frontal;
 pub mod quality;
 mod skip;
 
-pub use skip::{or_skip, python_modules};
+pub use skip::or_skip;
+#[cfg(feature = "socketcan")] // python-can's peer of the SocketCAN tests
+pub use skip::python_modules;
 
 /// The MakeHuman assets (`$DRESSFORM_MAKEHUMAN`, else `../shared/makehuman` beside the
 /// project), or `None` with a message when they are absent. With `DRESSFORM_REQUIRE_SHARED=1`
@@ -187,7 +189,7 @@ pub fn largest_mirror_gap(mesh: &Mesh, axis: f64) -> f64 {
 /// artifacts (noise, holes, metres, Y up, turned; `seed` picks them), written to
 /// `dir/scan.ply`.
 pub fn synthetic_scan(dir: &std::path::Path, seed: u64) -> PathBuf {
-    use sim::capture::{Artifacts, BodyParams, capture, generate};
+    use capture_sim::{Artifacts, BodyParams, capture, generate};
     let body = generate(&BodyParams::default()).expect("the default body generates");
     let raw = capture(&body, &Artifacts::typical_scanner(seed));
     let mesh =
@@ -199,12 +201,12 @@ pub fn synthetic_scan(dir: &std::path::Path, seed: u64) -> PathBuf {
 }
 
 /// A generated customer's surface as a mesh (in the canonical frame, as the generator makes it).
-pub fn mesh_of(body: &sim::capture::SyntheticBody) -> Mesh {
+pub fn mesh_of(body: &capture_sim::SyntheticBody) -> Mesh {
     surface_mesh(&body.surface)
 }
 
-/// A triangle surface of `sim` (a generated body's, or a simulated scan) as a mesh.
-pub fn surface_mesh(surface: &sim::capture::TriangleSurface) -> Mesh {
+/// A triangle surface of `capture-sim` (a generated body's, or a simulated scan) as a mesh.
+pub fn surface_mesh(surface: &capture_sim::TriangleSurface) -> Mesh {
     Mesh::new(
         surface.positions.iter().map(|&p| DVec3::from_array(p)).collect(),
         surface.triangles.clone(),

@@ -1,6 +1,6 @@
 //! Skip a test whose tool or data is missing, with a message, unless the environment says it
 //! is required (`DRESSFORM_REQUIRE_*=1`, as CI sets them): then the test fails. The one place
-//! that decides "skip or fail", for every crate's test binary (`sim/tests/main.rs` and
+//! that decides "skip or fail", for every crate's test binary (`sim/form-sim/tests/main.rs` and
 //! `firmware-protocol/tests/main.rs` include this file by path).
 
 use std::process::Command;

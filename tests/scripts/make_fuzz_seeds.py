@@ -110,7 +110,7 @@ def setpoints():
 
 
 def form():
-    put("form", "reference.toml", (ROOT / "sim" / "form-description" / "forms" / "reference.toml").read_bytes())
+    put("form", "reference.toml", (ROOT / "form-description" / "forms" / "reference.toml").read_bytes())
 
 
 def profiles(path):

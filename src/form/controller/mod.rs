@@ -39,6 +39,11 @@ pub mod open;
 pub mod plan;
 pub mod reset;
 pub mod session;
+#[cfg(feature = "simulator")]
+pub mod simulated;
+// Without the simulator: its types, and the refusal to start one.
+#[cfg(not(feature = "simulator"))]
+#[path = "no_simulator.rs"]
 pub mod simulated;
 pub mod status;
 pub mod transport;

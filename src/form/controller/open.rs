@@ -40,6 +40,6 @@ impl OpenLink {
             return Ok(OpenLink { connection: Connection::open(spec)?, rig: None });
         }
         let rig = SimulatedRig::start(form, sim)?;
-        Ok(OpenLink { connection: Connection::Sim(rig.attach()), rig: Some(rig) })
+        Ok(OpenLink { connection: rig.connect(), rig: Some(rig) })
     }
 }

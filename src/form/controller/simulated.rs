@@ -1,5 +1,5 @@
-//! The controller on the in-process simulated form (`sim::robot` on a `sim::bus::can` bus):
-//! try a set-point file without hardware, or chain mannequin → set-points → drive in tests
+//! The controller on the in-process simulated form (`form_sim::robot` on a `form_sim::bus::can`
+//! bus): try a set-point file without hardware, or chain mannequin → set-points → drive in tests
 //! and demos.
 //!
 //! A [`SimulatedRig`] is the form and its bus, living as long as the caller keeps it (one
@@ -9,11 +9,12 @@
 use std::path::PathBuf;
 
 use form_description::FormDescription;
-use sim::bus::can::{CanBus, CanKind};
-use sim::bus::candump::CandumpLog;
-use sim::fault::FaultSpec;
-use sim::robot::{FormState, SimError, SimOptions, SimulatedForm};
+use form_sim::bus::can::{CanBus, CanKind};
+use form_sim::bus::candump::CandumpLog;
+use form_sim::fault::FaultSpec;
+use form_sim::robot::{FormState, SimError, SimOptions, SimulatedForm};
 
+use super::transport::Connection;
 use super::transport::sim::SimBus;
 use super::{DriveError, DriveOptions, DriveReport, Progress, drive};
 use crate::form::setpoints::SetPoints;
@@ -88,6 +89,11 @@ impl SimulatedRig {
     /// The host's link to the form.
     pub fn attach(&self) -> SimBus {
         SimBus::attach(&self.bus)
+    }
+
+    /// The host's link to the form, as a [`Connection`].
+    pub fn connect(&self) -> Connection {
+        Connection::Sim(self.attach())
     }
 
     /// The truth about every node and actuator now.

@@ -3,7 +3,7 @@
 
 mod mesh;
 
-use dressform::scan::format::Format;
+use dressform::body::scan::format::Format;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|bytes: &[u8]| mesh::check(Format::Glb, bytes));

@@ -2,15 +2,15 @@
 //! the reference form (what `dressform setpoints` does next) without panicking.
 #![no_main]
 
-use dressform::profiles::Profiles;
+use dressform::shape::profiles::Profiles;
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 
 fuzz_target!(|bytes: &[u8]| {
     let form = form_description::reference();
-    let regions = dressform::fitting::regions_of(&form);
+    let regions = dressform::form::form_fit::regions_of(&form);
     let Ok(text) = std::str::from_utf8(bytes) else { return };
     if let Ok(profiles) = Profiles::parse(text, Path::new("fuzz.json"), &regions) {
-        let _ = dressform::fitting::fit(&profiles, &form);
+        let _ = dressform::form::form_fit::fit(&profiles, &form);
     }
 });

@@ -2,7 +2,7 @@
 //! the strokes never panic, and every checked target lies within its actuator's stroke.
 #![no_main]
 
-use dressform::setpoints::SetPoints;
+use dressform::form::setpoints::SetPoints;
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 

@@ -8,7 +8,9 @@
 //! | slcan (Lawicel USB-CAN adapter) on a serial port | [`slcan::Slcan`] | `tIIILDD..\r` text, classic CAN only | cyclically (CAN) |
 //! | SocketCAN interface | [`socketcan::SocketCan`] | kernel CAN frames, classic CAN | cyclically (CAN) |
 //!
-//! Every link sends through its [`Gate`]: the e-stop path (see [`gate`]).
+//! Every link sends through its [`Gate`]: the e-stop path (see [`gate`]). The simulated bus
+//! and SocketCAN are there with the cargo features `simulator` and `socketcan` (default); the
+//! serial links, and with them the e-stop over serial and slcan, are in every build.
 //!
 //! Packet handling: a received frame that does not decode (bad CRC, unknown code, invalid
 //! field, an extended or remote CAN frame) is dropped and counted, never an error; only the
@@ -18,8 +20,10 @@
 
 pub mod gate;
 pub mod serial;
+#[cfg(feature = "simulator")]
 pub mod sim;
 pub mod slcan;
+#[cfg(feature = "socketcan")]
 pub mod socketcan;
 
 mod line;
@@ -52,6 +56,14 @@ pub enum TransportError {
         device: String,
         /// The packet.
         what: String,
+    },
+    /// This dressform was built without the cargo feature the link needs.
+    #[error("{device}: this dressform was built without {feature}")]
+    NotBuilt {
+        /// The device.
+        device: String,
+        /// The missing feature, as the message names it.
+        feature: &'static str,
     },
     /// The link was e-stopped: only emergency stops go out any more.
     #[error("{device}: stopped by {cause}")]
@@ -107,8 +119,10 @@ pub enum Connection {
     /// An slcan adapter.
     Slcan(slcan::Slcan),
     /// A SocketCAN interface.
+    #[cfg(feature = "socketcan")]
     Can(socketcan::SocketCan),
     /// The simulated bus.
+    #[cfg(feature = "simulator")]
     Sim(sim::SimBus),
 }
 
@@ -118,7 +132,13 @@ impl Connection {
         match spec {
             LinkSpec::Serial(path) => Ok(Self::Serial(serial::SerialLine::open(path)?)),
             LinkSpec::Slcan(path) => Ok(Self::Slcan(slcan::Slcan::open(path)?)),
+            #[cfg(feature = "socketcan")]
             LinkSpec::Can(iface) => Ok(Self::Can(socketcan::SocketCan::open(iface)?)),
+            #[cfg(not(feature = "socketcan"))]
+            LinkSpec::Can(iface) => Err(TransportError::NotBuilt {
+                device: iface.clone(),
+                feature: "SocketCAN (cargo feature `socketcan`)",
+            }),
             LinkSpec::Sim => Err(TransportError::Unsupported {
                 device: "simulated bus".into(),
                 what: "a connection without a simulated form".into(),
@@ -144,7 +164,9 @@ impl Transport for Connection {
         match self {
             Self::Serial(t) => t.link(),
             Self::Slcan(t) => t.link(),
+            #[cfg(feature = "socketcan")]
             Self::Can(t) => t.link(),
+            #[cfg(feature = "simulator")]
             Self::Sim(t) => t.link(),
         }
     }
@@ -153,7 +175,9 @@ impl Transport for Connection {
         match self {
             Self::Serial(t) => t.device(),
             Self::Slcan(t) => t.device(),
+            #[cfg(feature = "socketcan")]
             Self::Can(t) => t.device(),
+            #[cfg(feature = "simulator")]
             Self::Sim(t) => t.device(),
         }
     }
@@ -162,7 +186,9 @@ impl Transport for Connection {
         match self {
             Self::Serial(t) => t.gate(),
             Self::Slcan(t) => t.gate(),
+            #[cfg(feature = "socketcan")]
             Self::Can(t) => t.gate(),
+            #[cfg(feature = "simulator")]
             Self::Sim(t) => t.gate(),
         }
     }
@@ -171,7 +197,9 @@ impl Transport for Connection {
         match self {
             Self::Serial(t) => t.recv().await,
             Self::Slcan(t) => t.recv().await,
+            #[cfg(feature = "socketcan")]
             Self::Can(t) => t.recv().await,
+            #[cfg(feature = "simulator")]
             Self::Sim(t) => t.recv().await,
         }
     }

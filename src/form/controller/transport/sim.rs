@@ -1,8 +1,8 @@
-//! The in-process simulated CAN bus (`sim::bus::can`), classic or FD: packets go through
+//! The in-process simulated CAN bus (`form_sim::bus::can`), classic or FD: packets go through
 //! `can::encode` / `can::decode` exactly as on a SocketCAN interface.
 
 use firmware_protocol::{Link, Packet, can};
-use sim::bus::can::{CanBus, CanReceiver, CanSender};
+use form_sim::bus::can::{CanBus, CanReceiver, CanSender};
 
 use super::gate::{Gate, PacketSink};
 use super::{Transport, TransportError};
