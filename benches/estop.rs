@@ -19,7 +19,7 @@ use dressform::form::controller::LinkSpec;
 use dressform::form::controller::control::socket_name;
 use firmware_protocol::drive::Faults;
 use form_description::reference;
-use form_sim::serve::{ServeConfig, Server, Transport, serve};
+use form_sim::serve::{PtyLink, ServeConfig, Server, serve};
 
 /// Tries per link.
 const TRIES: usize = 20;
@@ -97,7 +97,7 @@ fn estop_latency(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(1))
         .measurement_time(Duration::from_millis(100));
     let links =
-        [("serial", Transport::SerialPty, "--serial"), ("slcan", Transport::SlcanPty, "--slcan")];
+        [("serial", PtyLink::SerialPty, "--serial"), ("slcan", PtyLink::SlcanPty, "--slcan")];
     for ((link, transport, flag), silent) in
         links.into_iter().flat_map(|l| [(l, 0), (l, SILENT_CLIENTS)])
     {

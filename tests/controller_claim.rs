@@ -19,7 +19,7 @@ use embedded_can::{Frame as _, StandardId};
 use firmware_protocol::drive::{DriveCommand, Faults};
 use firmware_protocol::{Message, Packet, can};
 use form_description::reference;
-use form_sim::serve::{ServeConfig, Server, Transport, serve};
+use form_sim::serve::{PtyLink, ServeConfig, Server, serve};
 
 use crate::controller_estop::{flag, text};
 use crate::run_end_to_end::scan_file;
@@ -32,11 +32,11 @@ const CLAIM_TIMEOUT: Duration = Duration::from_secs(30);
 /// How long the nodes may take to latch an e-stop on a loaded machine (~10 ms quiet).
 const LATCH_TIMEOUT: Duration = Duration::from_secs(5);
 
-fn spec(server: &Server, transport: Transport) -> LinkSpec {
+fn spec(server: &Server, transport: PtyLink) -> LinkSpec {
     let path = server.device_path().to_path_buf();
     match transport {
-        Transport::SerialPty => LinkSpec::Serial(path),
-        Transport::SlcanPty => LinkSpec::Slcan(path),
+        PtyLink::SerialPty => LinkSpec::Serial(path),
+        PtyLink::SlcanPty => LinkSpec::Slcan(path),
     }
 }
 
@@ -129,7 +129,7 @@ fn nothing_moves_after_the_stop(log: &Path) {
 }
 
 /// `dressform estop` on the served form, from another process with `env` set.
-fn estop(server: &Server, transport: Transport, env: &[(&str, &Path)]) -> Output {
+fn estop(server: &Server, transport: PtyLink, env: &[(&str, &Path)]) -> Output {
     let mut command = Command::new(env!("CARGO_BIN_EXE_dressform"));
     command.args(["estop", flag(transport)]).arg(server.device_path());
     for (key, value) in env {
@@ -139,7 +139,7 @@ fn estop(server: &Server, transport: Transport, env: &[(&str, &Path)]) -> Output
 }
 
 /// `dressform run` of `scan` over the served form, as a child process.
-fn spawn_run(server: &Server, transport: Transport, scan: &Path, out: &Path) -> Child {
+fn spawn_run(server: &Server, transport: PtyLink, scan: &Path, out: &Path) -> Child {
     Command::new(env!("CARGO_BIN_EXE_dressform"))
         .args(["run", scan.to_str().unwrap(), flag(transport)])
         .arg(server.device_path())
@@ -161,7 +161,7 @@ enum Press {
 }
 
 /// `TRIES` runs over `transport`, each stopped while it computes.
-fn stopped_while_computing(transport: Transport, press: Press) {
+fn stopped_while_computing(transport: PtyLink, press: Press) {
     let dir = tempfile::tempdir().unwrap();
     let scan = scan_file(dir.path());
     for attempt in 0..TRIES {
@@ -216,17 +216,17 @@ fn stopped_while_computing(transport: Transport, press: Press) {
 
 #[test]
 fn estop_while_run_computes_ends_it_over_serial() {
-    stopped_while_computing(Transport::SerialPty, Press::Estop);
+    stopped_while_computing(PtyLink::SerialPty, Press::Estop);
 }
 
 #[test]
 fn estop_while_run_computes_ends_it_over_slcan() {
-    stopped_while_computing(Transport::SlcanPty, Press::Estop);
+    stopped_while_computing(PtyLink::SlcanPty, Press::Estop);
 }
 
 #[test]
 fn a_stop_latched_on_the_nodes_while_run_computes_is_not_cleared() {
-    for transport in [Transport::SerialPty, Transport::SlcanPty] {
+    for transport in [PtyLink::SerialPty, PtyLink::SlcanPty] {
         stopped_while_computing(transport, Press::OnTheNodes);
     }
 }
@@ -244,7 +244,7 @@ fn far_setpoints(dir: &Path) -> String {
 }
 
 /// A slow `drive` that has started moving.
-fn moving_drive(server: &Server, transport: Transport, setpoints: &str) -> Child {
+fn moving_drive(server: &Server, transport: PtyLink, setpoints: &str) -> Child {
     while server.form().state().actuators.iter().any(|a| a.state.moving) {
         std::thread::sleep(Duration::from_millis(2));
     }
@@ -269,7 +269,7 @@ fn moving_drive(server: &Server, transport: Transport, setpoints: &str) -> Child
 /// at once (the old endpoint answered one client at a time, a second each).
 #[test]
 fn silent_clients_do_not_delay_the_stop() {
-    for transport in [Transport::SerialPty, Transport::SlcanPty] {
+    for transport in [PtyLink::SerialPty, PtyLink::SlcanPty] {
         let server = serve(ServeConfig::new(reference(), transport)).unwrap();
         let dir = tempfile::tempdir().unwrap();
         let drive = moving_drive(&server, transport, &far_setpoints(dir.path()));
@@ -294,7 +294,7 @@ fn silent_clients_do_not_delay_the_stop() {
 /// `XDG_RUNTIME_DIR`, and the old endpoint's folder made beforehand by another user.
 #[test]
 fn estop_needs_no_shared_runtime_folder() {
-    for transport in [Transport::SerialPty, Transport::SlcanPty] {
+    for transport in [PtyLink::SerialPty, PtyLink::SlcanPty] {
         let server = serve(ServeConfig::new(reference(), transport)).unwrap();
         let dir = tempfile::tempdir().unwrap();
         let drive = moving_drive(&server, transport, &far_setpoints(dir.path()));
@@ -327,8 +327,8 @@ fn estop_needs_no_shared_runtime_folder() {
 fn ctrl_c_while_run_computes_stops_the_form_and_exits_1() {
     let dir = tempfile::tempdir().unwrap();
     let scan = scan_file(dir.path());
-    let server = serve(ServeConfig::new(reference(), Transport::SerialPty)).unwrap();
-    let mut run = spawn_run(&server, Transport::SerialPty, &scan, &dir.path().join("out"));
+    let server = serve(ServeConfig::new(reference(), PtyLink::SerialPty)).unwrap();
+    let mut run = spawn_run(&server, PtyLink::SerialPty, &scan, &dir.path().join("out"));
     let mut stderr = Stderr::of(&mut run);
     stderr.wait_for(CLAIMED, CLAIM_TIMEOUT);
     let pid = libc::pid_t::try_from(run.id()).unwrap();
@@ -346,7 +346,7 @@ fn ctrl_c_while_run_computes_stops_the_form_and_exits_1() {
 /// that holds the device, and says so; the form stops all the same.
 #[test]
 fn a_hung_owner_does_not_keep_the_stop_from_the_form() {
-    for transport in [Transport::SerialPty, Transport::SlcanPty] {
+    for transport in [PtyLink::SerialPty, PtyLink::SlcanPty] {
         let server = serve(ServeConfig::new(reference(), transport)).unwrap();
         let dir = tempfile::tempdir().unwrap();
         let drive = moving_drive(&server, transport, &far_setpoints(dir.path()));

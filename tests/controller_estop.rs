@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use firmware_protocol::drive::{DriveState, Faults};
 use form_sim::node::ActuatorFault;
-use form_sim::serve::{Server, Transport};
+use form_sim::serve::{PtyLink, Server};
 
 use crate::controller_pty::start;
 
@@ -21,10 +21,10 @@ const START_TIMEOUT: Duration = Duration::from_secs(30);
 /// gives the measured latency), this much on a loaded one.
 const LATCH_TIMEOUT: Duration = Duration::from_secs(5);
 
-pub(crate) fn flag(transport: Transport) -> &'static str {
+pub(crate) fn flag(transport: PtyLink) -> &'static str {
     match transport {
-        Transport::SerialPty => "--serial",
-        Transport::SlcanPty => "--slcan",
+        PtyLink::SerialPty => "--serial",
+        PtyLink::SlcanPty => "--slcan",
     }
 }
 
@@ -53,7 +53,7 @@ pub(crate) fn text(output: &Output) -> String {
 }
 
 /// `dressform drive FILE --serial|--slcan PTY`, moving slowly, as a child process.
-fn spawn_drive(server: &Server, transport: Transport, file: &str) -> Child {
+fn spawn_drive(server: &Server, transport: PtyLink, file: &str) -> Child {
     Command::new(env!("CARGO_BIN_EXE_dressform"))
         .args(["drive", file, flag(transport), server.device_path().to_str().unwrap()])
         .args(["--duration", "20"])
@@ -94,7 +94,7 @@ fn wait_latched(server: &Server) {
 }
 
 /// A drive that works: exit 0 and the panels where the file says.
-fn drive_works(server: &Server, transport: Transport, file: &str, extra: &[&str], mm: f64) {
+fn drive_works(server: &Server, transport: PtyLink, file: &str, extra: &[&str], mm: f64) {
     let device = server.device_path().to_str().unwrap();
     let mut args = vec!["drive", file, flag(transport), device];
     args.extend(extra);
@@ -110,7 +110,7 @@ fn drive_works(server: &Server, transport: Transport, file: &str, extra: &[&str]
 /// While `drive` moves the form, `estop` from another process latches every node and the
 /// drive exits 1 saying why; the next `drive` clears the e-stop and works; after an e-stop
 /// sent directly (no owner), `reset` clears it and `drive` works.
-fn estop_from_another_process(transport: Transport) {
+fn estop_from_another_process(transport: PtyLink) {
     let (_runtime, server) = start(transport);
     let dir = tempfile::tempdir().unwrap();
     let device = server.device_path().to_str().unwrap().to_string();
@@ -143,17 +143,17 @@ fn estop_from_another_process(transport: Transport) {
 
 #[test]
 fn estop_from_another_terminal_stops_a_serial_drive_and_the_form_recovers() {
-    estop_from_another_process(Transport::SerialPty);
+    estop_from_another_process(PtyLink::SerialPty);
 }
 
 #[test]
 fn estop_from_another_terminal_stops_an_slcan_drive_and_the_form_recovers() {
-    estop_from_another_process(Transport::SlcanPty);
+    estop_from_another_process(PtyLink::SlcanPty);
 }
 
 #[test]
 fn sigterm_to_a_moving_drive_latches_the_estop_on_every_node() {
-    for transport in [Transport::SerialPty, Transport::SlcanPty] {
+    for transport in [PtyLink::SerialPty, PtyLink::SlcanPty] {
         let (_runtime, server) = start(transport);
         let dir = tempfile::tempdir().unwrap();
         let far = setpoints(dir.path(), "far.json", 40.0);
@@ -171,7 +171,7 @@ fn sigterm_to_a_moving_drive_latches_the_estop_on_every_node() {
 
 /// A jam latches a following error; the next drive refuses to clear it on its own, naming
 /// it; once the jam is freed, `--reset-faults` clears it and the drive works.
-fn a_stall_needs_reset_faults(transport: Transport) {
+fn a_stall_needs_reset_faults(transport: PtyLink) {
     let (_runtime, server) = start(transport);
     let dir = tempfile::tempdir().unwrap();
     let near = setpoints(dir.path(), "near.json", 3.0);
@@ -203,10 +203,10 @@ fn a_stall_needs_reset_faults(transport: Transport) {
 
 #[test]
 fn after_a_stall_drive_refuses_without_reset_faults_and_works_with_it_over_serial() {
-    a_stall_needs_reset_faults(Transport::SerialPty);
+    a_stall_needs_reset_faults(PtyLink::SerialPty);
 }
 
 #[test]
 fn after_a_stall_drive_refuses_without_reset_faults_and_works_with_it_over_slcan() {
-    a_stall_needs_reset_faults(Transport::SlcanPty);
+    a_stall_needs_reset_faults(PtyLink::SlcanPty);
 }

@@ -33,7 +33,7 @@ use form_description::reference;
 use form_sim::bus::can::{CanBus, CanKind};
 use form_sim::fault::FaultSpec;
 use form_sim::robot::{FormState, SimOptions, SimulatedForm};
-use form_sim::serve::{ServeConfig, Transport as Served, serve};
+use form_sim::serve::{PtyLink, ServeConfig, serve};
 use tokio::time::Instant;
 
 /// The reference form on an in-process classic CAN bus with `faults`, a session with it
@@ -203,15 +203,15 @@ async fn a_fault_during_homing_or_a_move_leaves_no_node_enabled() {
 /// The same over both ptys, in real time: a jam during homing leaves no node Enabled.
 #[test]
 fn a_fault_during_homing_over_a_pty_leaves_no_node_enabled() {
-    for transport in [Served::SerialPty, Served::SlcanPty] {
+    for transport in [PtyLink::SerialPty, PtyLink::SlcanPty] {
         let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
         let mut config = ServeConfig::new(reference(), transport);
         config.faults = "chest-l1:stall@0s".parse().unwrap();
         let server = serve(config).unwrap();
         let path = server.device_path().to_path_buf();
         let spec = match transport {
-            Served::SerialPty => LinkSpec::Serial(path),
-            Served::SlcanPty => LinkSpec::Slcan(path),
+            PtyLink::SerialPty => LinkSpec::Serial(path),
+            PtyLink::SlcanPty => LinkSpec::Slcan(path),
         };
         let connection = Connection::open(&spec).unwrap();
         let options = DriveOptions::default();

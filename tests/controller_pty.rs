@@ -13,13 +13,13 @@ use dressform::form::setpoints::SetPoints;
 use firmware_protocol::NodeId;
 use firmware_protocol::drive::{DriveCommand, Faults};
 use form_description::reference;
-use form_sim::serve::{ServeConfig, Server, Transport as Served, serve};
+use form_sim::serve::{PtyLink, ServeConfig, Server, serve};
 use tokio::runtime::Runtime;
 use tokio::time::{Duration, Instant};
 
 /// The reference form served on a pty of `transport` (on its own thread), and a runtime for
 /// the host.
-pub(crate) fn start(transport: Served) -> (Runtime, Server) {
+pub(crate) fn start(transport: PtyLink) -> (Runtime, Server) {
     start_with(ServeConfig::new(reference(), transport))
 }
 
@@ -59,7 +59,7 @@ fn drive_over<T: Transport>(runtime: &Runtime, server: &Server, transport: T) {
 
 #[test]
 fn drives_the_form_over_a_serial_pty() {
-    let (runtime, server) = start(Served::SerialPty);
+    let (runtime, server) = start(PtyLink::SerialPty);
     let line = SerialLine::open(server.device_path()).unwrap();
     drive_over(&runtime, &server, line);
     // Status over the same pty afterwards: every node identified, Disabled, positions known.
@@ -78,7 +78,7 @@ fn drives_the_form_over_a_serial_pty() {
 
 #[test]
 fn drives_the_form_over_slcan_on_a_pty() {
-    let (runtime, server) = start(Served::SlcanPty);
+    let (runtime, server) = start(PtyLink::SlcanPty);
     let slcan = Slcan::open(server.device_path()).unwrap();
     drive_over(&runtime, &server, slcan);
 }
@@ -90,7 +90,7 @@ fn drives_the_form_over_slcan_on_a_pty() {
 #[test]
 fn a_host_that_went_away_leaves_no_answers_for_the_next() {
     use std::io::Write;
-    let (runtime, server) = start(Served::SlcanPty);
+    let (runtime, server) = start(PtyLink::SlcanPty);
     let mut gone = serialport::new(server.device_path().to_string_lossy(), 115_200)
         .timeout(Duration::from_millis(10))
         .open()
@@ -135,7 +135,7 @@ fn a_host_that_went_away_leaves_no_answers_for_the_next() {
 /// answer every poll are not lost for it, and the move completes.
 #[test]
 fn a_slow_serial_adapter_does_not_make_answering_nodes_lost() {
-    let mut config = ServeConfig::new(reference(), Served::SerialPty);
+    let mut config = ServeConfig::new(reference(), PtyLink::SerialPty);
     config.faults = "delay=20ms".parse().unwrap();
     let (runtime, server) = start_with(config);
     let line = SerialLine::open(server.device_path()).unwrap();
@@ -144,7 +144,7 @@ fn a_slow_serial_adapter_does_not_make_answering_nodes_lost() {
 
 #[test]
 fn an_emergency_stop_over_the_serial_pty_reaches_every_node() {
-    let (_runtime, server) = start(Served::SerialPty);
+    let (_runtime, server) = start(PtyLink::SerialPty);
     let connection = Connection::open(&LinkSpec::Serial(server.device_path().into())).unwrap();
     dressform::form::controller::emergency_stop(&connection).unwrap();
     std::thread::sleep(Duration::from_millis(100));
@@ -160,7 +160,7 @@ fn an_emergency_stop_over_the_serial_pty_reaches_every_node() {
 #[test]
 fn a_silent_serial_node_is_reported_while_the_others_answer() {
     const ONSET: Duration = Duration::from_secs(2);
-    let mut config = ServeConfig::new(reference(), Served::SerialPty);
+    let mut config = ServeConfig::new(reference(), PtyLink::SerialPty);
     config.faults = "node2:silent@2s".parse().unwrap();
     let (runtime, server) = start_with(config);
     let onset = std::time::Instant::now() + ONSET;

@@ -8,7 +8,7 @@ use dressform::body::mesh::Mesh;
 use dressform::body::scan::format::Format;
 use dressform::form::setpoints::SetPoints;
 use form_description::reference;
-use form_sim::serve::{ServeConfig, Transport, serve};
+use form_sim::serve::{PtyLink, ServeConfig, serve};
 use glam::DVec3;
 
 pub(crate) fn scan_file(dir: &std::path::Path) -> std::path::PathBuf {
@@ -25,7 +25,7 @@ fn scan_of(dir: &std::path::Path, params: &BodyParams) -> std::path::PathBuf {
     path
 }
 
-fn run_over(transport: Transport, flag: &str) {
+fn run_over(transport: PtyLink, flag: &str) {
     let tmp = tempfile::tempdir().unwrap();
     let scan = scan_file(tmp.path());
     let server = serve(ServeConfig::new(reference(), transport)).unwrap();
@@ -68,12 +68,12 @@ fn run_over(transport: Transport, flag: &str) {
 
 #[test]
 fn run_shapes_the_form_over_a_serial_pty() {
-    run_over(Transport::SerialPty, "--serial");
+    run_over(PtyLink::SerialPty, "--serial");
 }
 
 #[test]
 fn run_shapes_the_form_over_slcan() {
-    run_over(Transport::SlcanPty, "--slcan");
+    run_over(PtyLink::SlcanPty, "--slcan");
 }
 
 /// A slim customer: the reference form's waist is 695 mm at its smallest; the run drives the

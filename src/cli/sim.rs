@@ -3,7 +3,7 @@
 
 use super::Failure;
 use super::link::FormArg;
-use form_sim::serve::{ServeConfig, ServeError, Transport, run_until_ctrl_c};
+use form_sim::serve::{PtyLink, ServeConfig, ServeError, run_until_ctrl_c};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -35,7 +35,7 @@ pub fn run(args: &ServeArgs) -> Result<(), Failure> {
         .unwrap_or("")
         .parse()
         .map_err(|e| Failure::bad_input(format!("--faults: {e}")))?;
-    let transport = if args.serial_pty { Transport::SerialPty } else { Transport::SlcanPty };
+    let transport = if args.serial_pty { PtyLink::SerialPty } else { PtyLink::SlcanPty };
     let mut config = ServeConfig::new(form, transport);
     config.log = args.log.clone();
     config.faults = faults;

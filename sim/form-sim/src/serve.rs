@@ -1,18 +1,18 @@
 //! Serving a simulated form on a pseudo-terminal, for a host to connect to as to real
 //! hardware: the library side of `dressform sim`.
 //!
-//! * [`Transport::SerialPty`]: the form's nodes behind the protocol's serial mapping (1
+//! * [`PtyLink::SerialPty`]: the form's nodes behind the protocol's serial mapping (1
 //!   Mbaud timing); the host opens the slave path as a USB-serial or RS-485 adapter and
 //!   polls the nodes.
-//! * [`Transport::SlcanPty`]: the nodes on an in-process classic CAN bus at 1 Mbit/s behind
+//! * [`PtyLink::SlcanPty`]: the nodes on an in-process classic CAN bus at 1 Mbit/s behind
 //!   an slcan adapter ([`crate::bus::slcan`]); the host opens the slave path as a USB-CAN
 //!   adapter (python-can `interface="slcan"`, `slcand`).
 //!
 //! ```no_run
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
-//! use form_sim::serve::{ServeConfig, Transport};
+//! use form_sim::serve::{ServeConfig, PtyLink};
 //!
-//! let mut config = ServeConfig::new(form_description::reference(), Transport::SlcanPty);
+//! let mut config = ServeConfig::new(form_description::reference(), PtyLink::SlcanPty);
 //! config.log = Some("traffic.log".into());
 //! config.faults = "drop=0.01".parse()?;
 //! form_sim::serve::run_until_ctrl_c(config, |device| println!("{}", device.display()))?;
@@ -47,9 +47,10 @@ use crate::fault::FaultSpec;
 use crate::robot::{SimError, SimOptions, SimulatedForm};
 use form_description::FormDescription;
 
-/// How the host connects.
+/// How the host connects to the served form: which link runs on the pty (not the host's
+/// `Transport` trait, which a served form's host uses over either).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Transport {
+pub enum PtyLink {
     /// The protocol's serial mapping on a pty.
     SerialPty,
     /// A classic CAN bus behind an slcan adapter on a pty.
@@ -62,7 +63,7 @@ pub struct ServeConfig {
     /// The form.
     pub form: FormDescription,
     /// How the host connects.
-    pub transport: Transport,
+    pub transport: PtyLink,
     /// Where to write a candump log of the traffic.
     pub log: Option<PathBuf>,
     /// The run's faults.
@@ -73,7 +74,7 @@ pub struct ServeConfig {
 
 impl ServeConfig {
     /// `form` on `transport`, without log or faults, with default options.
-    pub fn new(form: FormDescription, transport: Transport) -> Self {
+    pub fn new(form: FormDescription, transport: PtyLink) -> Self {
         Self {
             form,
             transport,
@@ -185,8 +186,8 @@ async fn run_form(
     let canary = Arc::new(Mutex::new(Canary::open().map_err(ServeError::Pty)?));
     let device = pty.path().to_path_buf();
     let interface = match transport {
-        Transport::SerialPty => "serial0",
-        Transport::SlcanPty => "can0",
+        PtyLink::SerialPty => "serial0",
+        PtyLink::SlcanPty => "can0",
     };
     let log = match &log_path {
         Some(path) => Some(
@@ -196,7 +197,7 @@ async fn run_form(
         None => None,
     };
     match transport {
-        Transport::SerialPty => {
+        PtyLink::SerialPty => {
             let form = SimulatedForm::on_serial(&form, &faults, &options)?;
             let line = SerialLine::new(pty, DEFAULT_BAUD, &faults, log);
             let serving = form.serve_serial(line, options.tick, canary, stop);
@@ -206,7 +207,7 @@ async fn run_form(
             line.map_err(ServeError::Pty)?;
             log.map_err(log_error(&log_path))
         }
-        Transport::SlcanPty => {
+        PtyLink::SlcanPty => {
             let bus = Arc::new(CanBus::with(CanKind::CLASSIC_1M, &faults, log));
             let form = SimulatedForm::on_can_behind(&form, &bus, &faults, &options, Some(canary))?;
             let adapter = SlcanAdapter::new(pty, &bus);

@@ -12,7 +12,7 @@ use firmware_protocol::{
     ActuatorSet, Address, Code, Message, NodeId, PROTOCOL_VERSION, Packet, Position, serial,
 };
 use form_description::reference;
-use form_sim::serve::{ServeConfig, Transport, serve};
+use form_sim::serve::{PtyLink, ServeConfig, serve};
 use serialport::SerialPort;
 
 /// A blocking serial host.
@@ -68,7 +68,7 @@ impl Host {
 #[test]
 fn a_host_on_the_pty_identifies_every_node() {
     let description = reference();
-    let server = serve(ServeConfig::new(description.clone(), Transport::SerialPty)).unwrap();
+    let server = serve(ServeConfig::new(description.clone(), PtyLink::SerialPty)).unwrap();
     assert!(server.device_path().starts_with("/dev/pts"), "{:?}", server.device_path());
     let mut host = Host::open(server.device_path());
     for node in description.node_ids() {
@@ -94,7 +94,7 @@ fn a_host_on_the_pty_identifies_every_node() {
 
 #[test]
 fn garbage_on_the_line_is_skipped() {
-    let server = serve(ServeConfig::new(reference(), Transport::SerialPty)).unwrap();
+    let server = serve(ServeConfig::new(reference(), PtyLink::SerialPty)).unwrap();
     let mut host = Host::open(server.device_path());
     let garbage: Vec<u8> =
         (0..400u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8).collect();
@@ -112,7 +112,7 @@ fn garbage_on_the_line_is_skipped() {
 #[test]
 fn a_host_enables_homes_and_moves_a_node_over_the_pty() {
     let description = reference();
-    let server = serve(ServeConfig::new(description.clone(), Transport::SerialPty)).unwrap();
+    let server = serve(ServeConfig::new(description.clone(), PtyLink::SerialPty)).unwrap();
     let mut host = Host::open(server.device_path());
     let node = NodeId::new(7).unwrap();
     let ack = |request, status| Packet::node(node, Message::Ack(Ack { request, status }));
@@ -165,7 +165,7 @@ fn a_host_enables_homes_and_moves_a_node_over_the_pty() {
 fn the_serial_log_records_requests_and_answers() {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("serial.log");
-    let mut config = ServeConfig::new(reference(), Transport::SerialPty);
+    let mut config = ServeConfig::new(reference(), PtyLink::SerialPty);
     config.log = Some(log.clone());
     let server = serve(config).unwrap();
     let mut host = Host::open(server.device_path());
@@ -184,11 +184,11 @@ fn the_serial_log_records_requests_and_answers() {
 fn serving_refuses_bad_faults_and_stops_when_asked() {
     let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
     runtime.block_on(async {
-        let mut config = ServeConfig::new(reference(), Transport::SerialPty);
+        let mut config = ServeConfig::new(reference(), PtyLink::SerialPty);
         config.faults = "node12:reboot@1s".parse().unwrap();
         let error = serve(config).unwrap_err();
         assert!(error.to_string().contains("the form has no node 12"), "{error}");
-        for transport in [Transport::SerialPty, Transport::SlcanPty] {
+        for transport in [PtyLink::SerialPty, PtyLink::SlcanPty] {
             let server = serve(ServeConfig::new(reference(), transport)).unwrap();
             server.run_until(async {}).await.unwrap();
         }

@@ -9,12 +9,12 @@ use embedded_can::{Frame as _, StandardId};
 use firmware_protocol::can::Frame;
 use firmware_protocol::{Code, Message, can};
 use form_description::reference;
-use form_sim::serve::{ServeConfig, Server, Transport, serve};
+use form_sim::serve::{PtyLink, ServeConfig, Server, serve};
 use serialport::SerialPort;
 
 /// The reference form behind an slcan adapter.
 fn start() -> Server {
-    serve(ServeConfig::new(reference(), Transport::SlcanPty)).unwrap()
+    serve(ServeConfig::new(reference(), PtyLink::SlcanPty)).unwrap()
 }
 
 fn open(server: &Server) -> Box<dyn SerialPort> {

@@ -10,7 +10,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use form_description::reference;
-use form_sim::serve::{ServeConfig, Transport, serve};
+use form_sim::serve::{PtyLink, ServeConfig, serve};
 
 fn python_can_available() -> bool {
     crate::skip::or_skip(
@@ -42,7 +42,7 @@ fn python_can_identifies_every_node_over_slcan_and_reads_the_log() {
     let log = dir.path().join("slcan.log");
     let description = reference();
     let nodes = description.nodes.len().to_string();
-    let mut config = ServeConfig::new(description, Transport::SlcanPty);
+    let mut config = ServeConfig::new(description, PtyLink::SlcanPty);
     config.log = Some(log.clone());
     let server = serve(config).unwrap();
     let device = server.device_path().to_str().unwrap().to_string();
