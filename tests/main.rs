@@ -25,6 +25,7 @@ mod fuzz_readers;
 mod makehuman;
 mod mannequin;
 mod mannequin_file;
+mod mannequin_population;
 mod mannequin_quality;
 mod measurements;
 mod outputs;

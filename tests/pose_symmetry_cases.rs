@@ -10,25 +10,24 @@
 use crate::common;
 use common::Cuts;
 use common::frontal::{abduction, elevation};
+use common::makehuman_scan::{
+    girths, hole_sites, load, pose_of, posed, remesh_script, remesher, scanned, write_obj,
+};
 use dressform::body::mesh::Mesh;
 use dressform::body::segmented_body::SegmentedBody;
 use dressform::pose::body_model::BodyModel;
-use dressform::pose::makehuman::{MakeHuman, Pose};
+use dressform::pose::makehuman::MakeHuman;
 use dressform::run::reconstruct::{ReconstructOptions, reconstruct};
-use dressform::shape::measure::{central_loops, levels};
+use dressform::shape::measure::levels;
 use glam::{DQuat, DVec3};
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
-use rand_distr::{Distribution, Normal};
-use std::path::Path;
 
 /// The scanner's noise (mm), within issue 15's 0.5-1 mm.
 const NOISE_MM: f64 = 0.7;
 /// The marching-cubes grid's pitch (mm): a body scanner's mesh resolution.
 const PITCH_MM: f64 = 5.0;
-/// The holes' radius (mm) at the armpits and the crotch; the soles and the crown are cut this
-/// far in (a scanner sees neither).
-const HOLE_RADIUS_MM: f64 = 30.0;
+/// How far in the soles and the crown are cut (mm; a scanner sees neither).
 const CUT_MM: f64 = 15.0;
 /// How far the pose-symmetric scan's stature may lie outside the truth's (mm): ISO 20685-1's
 /// tolerance for stature from a scan.
@@ -166,11 +165,6 @@ fn cases() -> Vec<Case> {
     all
 }
 
-fn posed(mh: &MakeHuman, body: &[DVec3], bones: &[(String, DVec3)]) -> Mesh {
-    let pose = bones.iter().fold(Pose::rest(), |p, (b, t)| p.rotate(b, *t));
-    mh.base.skin(&mh.pose(body, &pose).unwrap())
-}
-
 /// Arm, clavicle and leg angles per side (L then R) of joints `at(name)` seen in `frame`.
 fn limb_angles(at: impl Fn(&str) -> DVec3, frame: DQuat) -> Vec<f64> {
     let mut angles = Vec::new();
@@ -185,64 +179,9 @@ fn limb_angles(at: impl Fn(&str) -> DVec3, frame: DQuat) -> Vec<f64> {
 
 const LIMB_NAMES: [&str; 6] = ["arm.L", "clav.L", "leg.L", "arm.R", "clav.R", "leg.R"];
 
-/// The scan's vertices moved by noise, with holes at `holes` and the soles and crown cut as
-/// `cuts` says.
-/// The soles end on the scanner's platform: every vertex left below `floor` + `cuts.soles_mm`
-/// (`floor` the body's lowest point before noise) is lifted onto that plane, so that the
-/// scan's floor is the platform's, not wherever the noise and the mesh's triangles put its
-/// lowest vertex (which moved the loaded scan 0-3 mm up or down, and its girths with it).
-fn scanned(mesh: &Mesh, floor: f64, holes: &[DVec3], cuts: Cuts, rng: &mut ChaCha8Rng) -> Mesh {
-    let noise = Normal::new(0.0, NOISE_MM).unwrap();
-    let mut mesh = mesh.clone();
-    for p in &mut mesh.positions {
-        *p += DVec3::new(noise.sample(rng), noise.sample(rng), noise.sample(rng));
-    }
-    let centres: Vec<DVec3> = holes
-        .iter()
-        .map(|h| {
-            *mesh.positions.iter().min_by(|a, c| a.distance(*h).total_cmp(&c.distance(*h))).unwrap()
-        })
-        .collect();
-    let platform = floor + cuts.soles_mm;
-    common::with_holes_and_cuts(mesh, &centres, HOLE_RADIUS_MM, cuts)
-        .map_positions(|p| DVec3::new(p.x, p.y, p.z.max(platform)))
-}
-
-/// Where a scanner leaves holes on a MakeHuman body whose bones have `heads`: under each arm,
-/// on the side of the chest (the arm hides it), and below the crotch.
-fn hole_sites(mh: &MakeHuman, heads: &[DVec3]) -> [DVec3; 3] {
-    let joint = |name: &str| heads[mh.rig.bone(name).unwrap()];
-    let under_arm = |side: &str| {
-        let (s, c) = (joint(&format!("upperarm01{side}")), joint(&format!("clavicle{side}")));
-        DVec3::new(s.x * 0.8, s.y, s.z - (s.x - c.x).abs())
-    };
-    let crotch = (joint("upperleg01.L") + joint("upperleg01.R")) / 2.0 - DVec3::Z * 100.0;
-    [under_arm(".L"), under_arm(".R"), crotch]
-}
-
 /// Whether an error is over its limit, or not a number (a section that was not found).
 fn exceeds(error: f64, limit: f64) -> bool {
     error.is_nan() || error > limit
-}
-
-fn write_obj(mesh: &Mesh, path: &Path) {
-    std::fs::write(path, dressform::body::scan::format::Format::Obj.encode(mesh)).unwrap();
-}
-
-/// A scan file read as the commands read it: into the canonical frame, then Taubin-smoothed
-/// (`--smooth`'s default).
-fn load(path: &Path) -> dressform::body::scan::Scan {
-    let mut scan = dressform::body::scan::load(path, &Default::default()).unwrap();
-    scan.body.taubin_smooth(dressform::body::mesh::smooth::DEFAULT_PASSES);
-    scan
-}
-
-/// The torso's tape girths of `body` at `heights`.
-fn girths(body: &Mesh, heights: &[f64]) -> Vec<f64> {
-    central_loops(body, 0.0, heights)
-        .into_iter()
-        .map(|c| c.map_or(f64::NAN, |c| c.tape_girth()))
-        .collect()
 }
 
 #[test]
@@ -274,8 +213,7 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
             let skin = posed(&mh, &body, bones);
             write_obj(&skin, &source);
             args.extend([source.display().to_string(), target.display().to_string()]);
-            let pose = bones.iter().fold(Pose::rest(), |p, (b, t)| p.rotate(b, *t));
-            let heads = mh.rig.bone_heads(&mh.pose(&body, &pose).unwrap());
+            let heads = mh.rig.bone_heads(&mh.pose(&body, &pose_of(bones)).unwrap());
             heads_and_floors.push((heads, skin.bounds().unwrap().min.z));
         }
         truths.push(heads_and_floors);
@@ -294,7 +232,14 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         };
         let [(heads, floor), (truth_heads, truth_floor)] = [&bodies[0], &bodies[1]];
         let joint = |name: &str| heads[mh.rig.bone(name).unwrap()];
-        let scan = scanned(&remeshed("scan"), *floor, &hole_sites(&mh, heads), SCANNER, &mut rng);
+        let scan = scanned(
+            &remeshed("scan"),
+            *floor,
+            &hole_sites(&mh, heads),
+            SCANNER,
+            NOISE_MM,
+            &mut rng,
+        );
         let yaw = DQuat::from_rotation_z(case.yaw_deg.to_radians());
         let (frame_name, unit, y_up) = FRAMES[case.frame];
         let file = scan.map_positions(|p| {
@@ -335,7 +280,14 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         // The same truth with its crown kept (the same noise), for the stature below.
         let (truth, crowned) = {
             let scan = |cuts: Cuts, mut rng: ChaCha8Rng, name: &str| {
-                let mesh = scanned(&remeshed("truth"), *truth_floor, &truth_sites, cuts, &mut rng);
+                let mesh = scanned(
+                    &remeshed("truth"),
+                    *truth_floor,
+                    &truth_sites,
+                    cuts,
+                    NOISE_MM,
+                    &mut rng,
+                );
                 let path = tmp.path().join(format!("{name}{i}.obj"));
                 write_obj(&mesh, &path);
                 load(&path)
@@ -347,8 +299,8 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
         };
         let at = levels(&SegmentedBody::find(&truth.body).unwrap());
         let heights = [at.chest, at.waist, at.hip];
-        let girth_want = girths(&truth.body, &heights);
-        let girth_got = girths(&rec.reposed.posed.body, &heights);
+        let girth_want = girths(&truth.body, 0.0, &heights);
+        let girth_got = girths(&rec.reposed.posed.body, 0.0, &heights);
         let girth_err: Vec<f64> =
             girth_want.iter().zip(&girth_got).map(|(a, b)| (a - b).abs()).collect();
         let girth_mean = girth_err.iter().sum::<f64>() / 3.0;
@@ -444,23 +396,6 @@ fn reconstruct_recovers_poses_and_girths_over_the_acceptance_table() {
     assert!(misses.is_empty(), "{} misses:\n{}", misses.len(), misses.join("\n"));
 }
 
-fn remesh_script() -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scripts/remesh.py")
-}
-
-/// python3, when it has what `remesh.py` imports.
-fn remesher() -> Result<String, String> {
-    let probe = std::process::Command::new("python3")
-        .args(["-c", "import trimesh, scipy, skimage"])
-        .output()
-        .map_err(|e| format!("python3: {e}"))?;
-    if probe.status.success() {
-        Ok("python3".into())
-    } else {
-        Err(String::from_utf8_lossy(&probe.stderr).lines().last().unwrap_or_default().to_string())
-    }
-}
-
 /// Issue 15, a different deformer: the sim generator's bodies (capsule limbs, no skinning)
 /// standing asymmetrically, captured with a typical scanner's noise and holes, against the
 /// same `BodyParams` in the symmetric A-pose captured alike: the pose-symmetric scan's chest,
@@ -501,8 +436,10 @@ fn reconstruct_straightens_the_sim_generators_asymmetric_bodies() {
         let rec = reconstruct(&scan, &model, &ReconstructOptions::default(), |_| {})
             .unwrap_or_else(|e| panic!("sim body, {what}: {e}"));
         let heights = [at.chest.min(rec.result.comparison.levels.chest), at.waist, at.hip];
-        let (want, got) =
-            (girths(&reference.body, &heights), girths(&rec.reposed.posed.body, &heights));
+        let (want, got) = (
+            girths(&reference.body, 0.0, &heights),
+            girths(&rec.reposed.posed.body, 0.0, &heights),
+        );
         let err: Vec<f64> = want.iter().zip(&got).map(|(a, b)| (a - b).abs()).collect();
         eprintln!(
             "sim body, {what}: fit {:.1} s, rms {:.2}/{:.2} mm; chest, waist, hip {want:.0?} pose-symmetric {got:.0?} off {err:.1?} mm",

@@ -7,8 +7,18 @@
 //! rotation `R` into `M R M`, whose vector is `det(M) M w`). So the symmetric pose is:
 //! - a bone on the midline (root, spine, neck, head) keeps only its turn about X, the forward
 //!   bend: its sideways bend (about Y) and its twist or turn (about Z) go to zero;
-//! - a left/right pair takes the mean of the left angle and the mirrored right one, and the
-//!   right bone the mirror of that mean: arms and legs at the mean of the two sides.
+//! - a left/right pair (arms, legs) stands, as the paper does ([`Limbs::Mean`], the default),
+//!   at the mean of the left angle and the mirrored right one, the right bone the mirror of
+//!   that mean; or (`limbs = "rest"` in a pose file, [`Limbs::Rest`]) at the body model's rest:
+//!   the same stance for every customer however they stood, and the stance the model's shapes
+//!   and weights come from (MakeHuman's rest: arms 40 degrees out, legs 8).
+//!
+//! Why the rest is offered (and is the candidate default, issue 35): the torso's shape under the arms and its height
+//! above the floor follow the limbs. On 4 MakeHuman bodies standing slightly asymmetric (an arm
+//! 11-17 degrees further out, a leg 3-8), the mean stance put the pose-symmetric scan's chest
+//! +7 to +16 mm over the same body un-posed at its chest level (the arms further out stretch the
+//! skin under them; the legs further out lower the crotch 4-8 mm), the waist up to -13; at the
+//! rest stance the waist and hip came within 1 mm (`tests/mannequin_population.rs`, issue 35).
 //!
 //! A `pose.toml` ([`PoseOverrides`]) then sets any named joint; the re-posed scan is the scan
 //! moved, bone by bone, from the fitted pose to that one ([`repose`]).
@@ -29,23 +39,41 @@ pub fn mirror(theta: DVec3) -> DVec3 {
     DVec3::new(theta.x, -theta.y, -theta.z)
 }
 
+/// Where the symmetric pose puts the arms and legs (see the module documentation).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Limbs {
+    /// At the body model's rest: the same stance for every scan.
+    Rest,
+    /// At the mean of the two sides (the paper's).
+    #[default]
+    Mean,
+}
+
 /// The symmetric pose of `theta` (see the module documentation). Rotation vectors are
 /// averaged component by component, so a midline bone keeps exactly its forward bend `x`.
-pub fn symmetric(theta: &[DVec3], skeleton: &Skeleton) -> Vec<DVec3> {
+pub fn symmetric(theta: &[DVec3], skeleton: &Skeleton, limbs: Limbs) -> Vec<DVec3> {
     let partner = skeleton.mirror();
     let mean = |b: usize| (theta[b] + mirror(theta[partner[b]])) / 2.0;
-    // The second bone of a pair takes the mirror of the first's mean: exactly symmetric.
     (0..theta.len())
-        .map(|b| if partner[b] < b { mirror(mean(partner[b])) } else { mean(b) })
+        .map(|b| match (partner[b] == b, limbs) {
+            (false, Limbs::Rest) => DVec3::ZERO,
+            // The second bone of a pair takes the mirror of the first's mean: exactly symmetric.
+            _ if partner[b] < b => mirror(mean(partner[b])),
+            _ => mean(b),
+        })
         .collect()
 }
 
-/// Joint angles a user sets on the symmetric pose (`--pose pose.toml`): a `[joints]` table of
-/// bone name to rotation vector `[x, y, z]` in degrees (the convention of
-/// [`crate::pose::skinning`]). A joint set on one side only is mirrored onto the other, so the pose
-/// stays symmetric; set both sides to make it asymmetric on purpose.
+/// What a user sets on the symmetric pose (`--pose pose.toml`): where the limbs stand
+/// (`limbs = "rest"` or `"mean"`, see [`Limbs`]), and a `[joints]` table of bone name to
+/// rotation vector `[x, y, z]` in degrees (the convention of [`crate::pose::skinning`]). A joint
+/// set on one side only is mirrored onto the other, so the pose stays symmetric; set both sides
+/// to make it asymmetric on purpose.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PoseOverrides {
+    /// Where the limbs stand before the joints are set.
+    pub limbs: Limbs,
     /// Bone index and rotation vector (radians).
     pub joints: Vec<(usize, DVec3)>,
 }
@@ -54,6 +82,9 @@ pub struct PoseOverrides {
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct PoseFile {
+    #[serde(default)]
+    limbs: Limbs,
+    #[serde(default)]
     joints: BTreeMap<String, [f64; 3]>,
 }
 
@@ -90,7 +121,7 @@ impl PoseOverrides {
             joints.push((bone, v * std::f64::consts::PI / 180.0));
         }
         crate::input::check(path, if problems.is_empty() { Ok(()) } else { Err(problems) })?;
-        Ok(PoseOverrides { joints })
+        Ok(PoseOverrides { limbs: file.limbs, joints })
     }
 
     /// `theta` with the overrides set (mirrored onto a partner the file does not name).
@@ -154,12 +185,16 @@ mod tests {
             DVec3::new(0.0, -0.4, 0.0),
             DVec3::new(0.0, 0.2, 0.0),
         ];
-        let sym = symmetric(&theta, &s);
+        let sym = symmetric(&theta, &s, Limbs::Mean);
         assert!(sym[0].distance(DVec3::new(0.1, 0.0, 0.0)) < 1e-12, "{}", sym[0]);
         assert!(sym[1].distance(DVec3::new(-0.2, 0.0, 0.0)) < 1e-12, "{}", sym[1]);
         // Left arm down by 0.4, the right (mirrored) by 0.2: both at 0.3.
         assert!(sym[2].distance(DVec3::new(0.0, -0.3, 0.0)) < 1e-12, "{}", sym[2]);
         assert_eq!(sym[3], mirror(sym[2]));
+        // At rest the arms stand as the model's rest, the midline as with the mean.
+        let rest = symmetric(&theta, &s, Limbs::Rest);
+        assert_eq!(rest[..2], sym[..2]);
+        assert_eq!(rest[2..], [DVec3::ZERO; 2]);
     }
 
     #[test]
@@ -167,6 +202,9 @@ mod tests {
         let s = skeleton();
         let o = PoseOverrides::parse("[joints]\n\"arm.L\" = [0, -30, 0]\n", Path::new("p"), &s)
             .unwrap();
+        assert_eq!(o.limbs, Limbs::Mean);
+        let mean = PoseOverrides::parse("limbs = \"rest\"\n", Path::new("p"), &s).unwrap();
+        assert_eq!((mean.limbs, mean.joints.len()), (Limbs::Rest, 0));
         let mut theta = vec![DVec3::ZERO; 4];
         o.apply(&mut theta, &s);
         assert!((theta[2].y + 30f64.to_radians()).abs() < 1e-12);

@@ -143,7 +143,8 @@ pub fn repose(
     let rig = rig_transfer::transfer(body, &fitted_mesh, &model.weights, bones);
 
     progress(2);
-    let mut symmetric = pose_symmetry::symmetric(&fitted.theta, &model.skeleton);
+    let mut symmetric =
+        pose_symmetry::symmetric(&fitted.theta, &model.skeleton, options.pose.limbs);
     options.pose.apply(&mut symmetric, &model.skeleton);
     let moved = pose_symmetry::repose(
         &body.positions,

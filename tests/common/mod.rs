@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 pub mod frontal;
+pub mod makehuman_scan;
 pub mod quality;
 mod skip;
 
