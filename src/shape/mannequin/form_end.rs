@@ -38,8 +38,8 @@ impl StopAt {
 
 /// The knee joint's height as a share of the body's height (Winter, *Biomechanics and Motor
 /// Control of Human Movement*, 4th ed., Fig. 4.1: 0.285 H). On the demo's customer (1700 mm,
-/// crotch at 789) mid-thigh falls 152 mm below the crotch; the reference form's thigh rings
-/// shape it 102 mm below.
+/// crotch at 789-794) mid-thigh falls about 155 mm below the crotch; the reference form's
+/// thigh rings shape it 102 mm below.
 const KNEE_SHARE: f64 = 0.285;
 
 /// The number of a leg's rings (bottom to top; `is_layer` flags its layers) to drop so that
