@@ -238,6 +238,20 @@ fn bad_flags_are_usage_errors() {
         assert_eq!(code, 2, "{stderr}");
         assert!(stderr.contains(&format!("{flag}: NaN is not a height")), "{stderr}");
     }
+    // The legs' options, shared by every command that builds a mannequin: clap's error, naming
+    // the flag and the values it takes.
+    for command in
+        [&["symmetrize", "x.obj"][..], &["reconstruct", "x.obj"], &["run", "x.obj"], &["demo"]]
+    {
+        for (flag, value, values) in
+            [("--legs", "bent", "straight, as-scanned"), ("--stop-at", "knee", "thigh")]
+        {
+            let (code, _, stderr) = dressform(&[command, &[flag, value]].concat());
+            assert_eq!(code, 2, "{command:?} {flag}: {stderr}");
+            let named = format!("invalid value '{value}' for '{flag}");
+            assert!(stderr.contains(&named) && stderr.contains(values), "{stderr}");
+        }
+    }
 }
 
 /// Output streams that fail: a reader that closed the pipe ends the output quietly; a full

@@ -140,6 +140,66 @@ fn options_change_the_layer_and_ray_counts() {
     assert_eq!(layers[79]["points"].as_array().unwrap().len(), 118);
 }
 
+/// The legs' options through `symmetrize`: straight by default, as scanned on asking, with the
+/// same hips and inseam either way; `--stop-at thigh` ends the legs at mid-thigh, closed,
+/// with fewer leg layers in `profiles.json`.
+#[test]
+fn leg_stance_and_stop_at_thigh() {
+    let Some(dir) = makehuman() else { return };
+    let base = dir.join("base.obj");
+    let tmp = tempfile::tempdir().unwrap();
+    let build = |name: &str, flags: &[&str]| {
+        let out = tmp.path().join(name);
+        let mut args = vec![base.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend(flags);
+        let (code, _, stderr) = symmetrize_cli(&args);
+        assert_eq!(code, 0, "{flags:?}: {stderr}");
+        let mesh = dressform::body::scan::read_mesh(&out.join("mannequin.obj")).unwrap().0;
+        let profiles: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("profiles.json")).unwrap()).unwrap();
+        (mesh, profiles)
+    };
+    let (straight, straight_p) = build("straight", &[]);
+    let (scanned, scanned_p) = build("as-scanned", &["--legs", "as-scanned"]);
+    let (thigh, thigh_p) = build("thigh", &["--stop-at", "thigh"]);
+
+    let layers = |p: &serde_json::Value, region: &str| -> Vec<serde_json::Value> {
+        let all = p["layers"].as_array().unwrap().iter();
+        all.filter(|l| l["region"] == region).cloned().collect()
+    };
+    let centre_x = |l: &serde_json::Value| l["centre"][0].as_f64().unwrap();
+    // The torso (its hip among it) bit for bit the same; every leg layer's girth too.
+    assert_eq!(layers(&straight_p, "torso"), layers(&scanned_p, "torso"));
+    for (a, b) in layers(&straight_p, "left_leg").iter().zip(&layers(&scanned_p, "left_leg")) {
+        assert_eq!(a["z"], b["z"]);
+        let (ga, gb) = (a["tape_girth"].as_f64().unwrap(), b["tape_girth"].as_f64().unwrap());
+        assert!((ga - gb).abs() < 1e-6, "a leg layer's girth at {}: {ga} against {gb}", a["z"]);
+    }
+    // Straight: the ankle under the thigh; as scanned (MakeHuman stands 10 degrees out), out.
+    let splay = |p: &serde_json::Value| {
+        let left = layers(p, "left_leg");
+        centre_x(&left[0]) - centre_x(&left[left.len() - 1])
+    };
+    assert!(splay(&straight_p).abs() < 10.0, "straight: {:.1} mm", splay(&straight_p));
+    assert!(splay(&scanned_p) > 50.0, "as scanned: {:.1} mm", splay(&scanned_p));
+    for (what, mesh) in [("straight", &straight), ("as scanned", &scanned), ("thigh", &thigh)] {
+        let t = topology(mesh);
+        assert!(t.is_closed() && t.is_manifold() && t.is_consistently_oriented(), "{what}: {t:?}");
+    }
+    // At the thigh: the full legs' top layers, none below mid-thigh, the torso unchanged.
+    let (full, cut) = (layers(&straight_p, "left_leg"), layers(&thigh_p, "left_leg"));
+    let lm = &straight_p["landmarks"];
+    let (crotch, height) = (lm["crotch_mm"].as_f64().unwrap(), lm["height_mm"].as_f64().unwrap());
+    let mid_thigh = 0.5 * (crotch + 0.285 * height);
+    let lowest = cut[0]["z"].as_f64().unwrap();
+    assert!(lowest <= mid_thigh && lowest > mid_thigh - 20.0, "{lowest} against {mid_thigh}");
+    assert!(cut.len() < full.len() / 2, "{} leg layers of {}", cut.len(), full.len());
+    assert_eq!(cut[..], full[full.len() - cut.len()..]);
+    assert_eq!(layers(&thigh_p, "torso"), layers(&straight_p, "torso"));
+    let bottom = thigh.bounds().unwrap().min.z;
+    assert!((bottom - lowest).abs() < 1e-3, "the mesh ends at {bottom}, the legs at {lowest}");
+}
+
 /// A closed ellipsoid "body" of human height, without legs or arms.
 fn ellipsoid(dir: &Path) -> std::path::PathBuf {
     let mut mesh = dressform::body::mesh::Mesh::default();

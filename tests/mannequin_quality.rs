@@ -23,7 +23,7 @@ use dressform::pose::body_model::BodyModel;
 use dressform::pose::makehuman::{MakeHuman, Pose as MhPose};
 use dressform::run::pipeline::{Symmetrized, symmetrize};
 use dressform::run::reconstruct::{ReconstructOptions, reconstruct};
-use dressform::shape::mannequin::{Layer, Mannequin, MannequinOptions};
+use dressform::shape::mannequin::{Layer, LegStance, Mannequin, MannequinOptions};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::path::Path;
@@ -138,6 +138,12 @@ struct Report {
     /// Abduction of the input's left leg, of its mirrored right leg, and of the mannequin's
     /// legs (degrees).
     leg_deg: [f64; 3],
+    /// The mannequin's legs' lean forward (degrees; see [`flexion_deg`]).
+    leg_flexion_deg: f64,
+    /// How the mannequin's legs stand.
+    legs: LegStance,
+    /// The smallest gap between the two legs' layers (mm).
+    leg_gap: f64,
     /// The largest height difference between the mannequin's shoulder line and the body's
     /// (mm), where the shoulders are known.
     shoulder_line: Option<f64>,
@@ -155,8 +161,12 @@ const SLICE_STEP_MM: f64 = 2.0;
 const WIDTH_JUMP_MM: f64 = 15.0;
 /// How far the mannequin's shoulder line may be from the body's (mm), from the issue.
 const SHOULDER_LINE_MM: f64 = 5.0;
-/// How close the mannequin's leg direction is to the mean of the input's (degrees).
+/// How close the mannequin's leg direction is to the mean of the input's (degrees), when its
+/// legs stand as the customer stood.
 const LEG_STANCE_DEG: f64 = 0.5;
+/// How close to vertical the mannequin's legs' axes are (degrees, sideways and front to back),
+/// when they stand straight: issue 35's acceptance.
+const STRAIGHT_LEG_DEG: f64 = 1.0;
 /// The most the left arm plate's rim may turn in all (degrees): a convex curve turns 360, and
 /// each step of a staircase (one per layer, 15-20 layers up each side) adds about 180; the
 /// rims, one curve, turn 360-454 degrees on the generator's bodies, 384 on the asymmetric
@@ -425,6 +435,12 @@ fn report(case: &Case, out: &Symmetrized) -> Report {
         abduction_deg(&centres)
     };
     let mannequin_leg: Vec<(f64, f64)> = m.left_leg.iter().map(|l| (l.z, l.centre[0])).collect();
+    let mannequin_lean: Vec<(f64, f64)> = m.left_leg.iter().map(|l| (l.z, l.centre[1])).collect();
+    let leg_gap = m
+        .left_leg
+        .iter()
+        .map(|l| 2.0 * l.points.iter().map(|p| p.x - m.axis).fold(f64::INFINITY, f64::min))
+        .fold(f64::INFINITY, f64::min);
     Report {
         name: case.name.clone(),
         width_jump: width_jump(&m.mesh, f64::NEG_INFINITY, shoulders),
@@ -448,6 +464,9 @@ fn report(case: &Case, out: &Symmetrized) -> Report {
             -input_leg(Region::RightLeg),
             abduction_deg(&mannequin_leg),
         ],
+        leg_flexion_deg: flexion_deg(&mannequin_lean),
+        legs: m.options.legs,
+        leg_gap,
         shoulder_line: case.acromions.map(|a| shoulder_line_gap(case, out, a)),
         rim: {
             let plate = m.own_landmarks().left_armhole;
@@ -499,6 +518,18 @@ const ARMS_BEYOND: f64 = 1.5;
 /// A leg's abduction from its section centres (height, x): the angle from vertical of the
 /// least-squares line x(z), positive with the foot outward to +X.
 fn abduction_deg(centres: &[(f64, f64)]) -> f64 {
+    lean_deg(centres)
+}
+
+/// A leg's lean forward from its section centres (height, y): the angle from vertical of the
+/// least-squares line y(z), positive with the foot forward (to -Y, the way the subject faces).
+fn flexion_deg(centres: &[(f64, f64)]) -> f64 {
+    -lean_deg(centres)
+}
+
+/// The angle from vertical of the least-squares line c(z) through `centres` (height, c),
+/// positive where c grows downward.
+fn lean_deg(centres: &[(f64, f64)]) -> f64 {
     let n = centres.len() as f64;
     let (mz, mx) = centres.iter().fold((0.0, 0.0), |(a, b), &(z, x)| (a + z / n, b + x / n));
     let (szz, szx) = centres
@@ -517,13 +548,13 @@ fn look(case: &Case, out: &Symmetrized) {
     }
 }
 
-/// Builds every case's mannequin, prints the table and checks every row.
-fn check_all(cases: Vec<Case>) {
+/// Builds every case's mannequin with `options`, prints the table and checks every row.
+fn check_all(cases: Vec<Case>, options: &MannequinOptions) {
     check_reports(
         cases
             .par_iter()
             .map(|case| {
-                let out = symmetrize(&case.scan, &MannequinOptions::default(), |_| {})
+                let out = symmetrize(&case.scan, options, |_| {})
                     .unwrap_or_else(|e| panic!("{}: {e}", case.name));
                 look(case, &out);
                 report(case, &out)
@@ -535,7 +566,7 @@ fn check_all(cases: Vec<Case>) {
 /// Prints the table of `reports` and checks every row.
 fn check_reports(reports: Vec<Report>) {
     eprintln!(
-        "{:<12} {:>15} {:>15} {:>9} {:>22} {:>7} {:>11} {:>9} {:>11} {:>6} {:>7} {:>7} {:>15} {:>13} {:>17} {:>8} {:>14}",
+        "{:<12} {:>15} {:>15} {:>9} {:>22} {:>7} {:>11} {:>9} {:>11} {:>6} {:>7} {:>7} {:>15} {:>13} {:>23} {:>7} {:>8} {:>14}",
         "mannequin",
         "width jump (z)",
         "underarm (z)",
@@ -550,13 +581,14 @@ fn check_reports(reports: Vec<Report>) {
         "girth",
         "bent/cap girth",
         "jump body/us",
-        "legs deg: L/R/out",
+        "legs deg: L/R/out/fwd",
+        "leg gap",
         "line",
         "rim deg/n/flat"
     );
     for r in &reports {
         eprintln!(
-            "{:<12} {:>6.1} ({:>6.0}) {:>6.1} ({:>6.0}) {:>9} {:>6.1} {:>7.0} {:>7.0} {:>+7.2} {:>5.1}/{:>5.1} {:>4.1}/{:>4.1} {:>5.1}/{:>5.1} {:>6.1} {:>7.3} {:>7.3} {:>7.1}/{:>7.1} {:>6.1}/{:>6.1} {:>5.1} {:>5.1} {:>5.1} {:>8} {:>14}",
+            "{:<12} {:>6.1} ({:>6.0}) {:>6.1} ({:>6.0}) {:>9} {:>6.1} {:>7.0} {:>7.0} {:>+7.2} {:>5.1}/{:>5.1} {:>4.1}/{:>4.1} {:>5.1}/{:>5.1} {:>6.1} {:>7.3} {:>7.3} {:>7.1}/{:>7.1} {:>6.1}/{:>6.1} {:>5.1} {:>5.1} {:>5.1} {:>5.2} {:>7.1} {:>8} {:>14}",
             r.name,
             r.width_jump.0,
             r.width_jump.1,
@@ -583,6 +615,8 @@ fn check_reports(reports: Vec<Report>) {
             r.leg_deg[0],
             r.leg_deg[1],
             r.leg_deg[2],
+            r.leg_flexion_deg,
+            r.leg_gap,
             r.shoulder_line.map_or("-".into(), |g| format!("{g:.1}")),
             r.rim.map_or("-".into(), |r| format!(
                 "{:.0}/{}/{:.1}",
@@ -643,9 +677,23 @@ fn check_reports(reports: Vec<Report>) {
         assert!(turning <= RIM_TURNING_DEG, "{name}: the arm plate's rim turns {turning:.0} deg");
         assert!(flat <= RIM_FLAT_BOTTOM_MM, "{name}: the arm plate's rim is flat for {flat:.1} mm");
         assert!(r.recorded_girth_error < 0.1, "{name}: a layer misreports its girth: {r:?}");
-        // The stance: the mean of the left leg's direction and the right leg's mirrored.
-        let stance = 0.5 * (r.leg_deg[0] + r.leg_deg[1]);
-        assert!((r.leg_deg[2] - stance).abs() < LEG_STANCE_DEG, "{name}: legs {:?}", r.leg_deg);
+        assert!(r.leg_gap >= 0.0, "{name}: the legs run into each other: {:.1} mm", r.leg_gap);
+        match r.legs {
+            // Parallel and vertical.
+            LegStance::Straight => assert!(
+                r.leg_deg[2].abs() <= STRAIGHT_LEG_DEG
+                    && r.leg_flexion_deg.abs() <= STRAIGHT_LEG_DEG,
+                "{name}: the legs lean {:.2} deg out and {:.2} forward",
+                r.leg_deg[2],
+                r.leg_flexion_deg
+            ),
+            // The mean of the left leg's direction and the right leg's mirrored.
+            LegStance::AsScanned => {
+                let stance = 0.5 * (r.leg_deg[0] + r.leg_deg[1]);
+                let off = (r.leg_deg[2] - stance).abs();
+                assert!(off < LEG_STANCE_DEG, "{name}: legs {:?}", r.leg_deg);
+            }
+        }
     }
 }
 
@@ -653,7 +701,18 @@ fn check_reports(reports: Vec<Report>) {
 fn the_demo_customer_the_asymmetric_example_and_the_makehuman_body() {
     let mut cases = vec![demo_customer(), asymmetric(), arm_out()];
     cases.extend(makehuman_base());
-    check_all(cases);
+    check_all(cases, &MannequinOptions::default());
+}
+
+/// Legs standing as the customer stood: the demo's customer (legs 6 degrees out) and the
+/// asymmetric example (the left leg 15 degrees out, the right 6) and the MakeHuman body (whose
+/// thighs nearly touch).
+#[test]
+fn legs_as_scanned() {
+    let options = MannequinOptions { legs: LegStance::AsScanned, ..Default::default() };
+    let mut cases = vec![arm_out(), asymmetric()];
+    cases.extend(makehuman_base());
+    check_all(cases, &options);
 }
 
 #[test]
@@ -662,7 +721,7 @@ fn twenty_random_customers() {
         .into_par_iter()
         .map(|s| generated(format!("random-{s}"), &BodyParams::random(s)))
         .collect();
-    check_all(cases);
+    check_all(cases, &MannequinOptions::default());
 }
 
 /// A body through `reconstruct` (pose symmetry, then the mannequin): the pose-symmetric scan

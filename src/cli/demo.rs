@@ -8,7 +8,7 @@
 
 use super::drive::{SimArgs, shape_verdict};
 use super::run::{Drive, Prepared, Reconstruct, shape_form};
-use super::{Failure, progress_bar};
+use super::{Failure, LegArgs, progress_bar};
 use capture_sim::{Artifacts, BodyParams, GroundTruth, Pose, capture, generate};
 use dressform::atomic_output::OutputSet;
 use dressform::body::mesh::{Mesh, smooth::DEFAULT_PASSES};
@@ -19,6 +19,7 @@ use dressform::form::form_fit::DEFAULT_GIRTH_TOLERANCE_MM;
 use dressform::pose::body_model::BodyModel;
 use dressform::run::info::ScanInfo;
 use dressform::run::reconstruct::{MeasurementsReport, ReconstructOptions};
+use dressform::shape::mannequin::MannequinOptions;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 
@@ -31,6 +32,8 @@ pub struct DemoArgs {
     /// with chest 960, waist 800 and hip 1000 mm).
     #[arg(long)]
     seed: Option<u64>,
+    #[command(flatten)]
+    legs: LegArgs,
 }
 
 /// How much further out the customer holds the left arm than the right (degrees of
@@ -57,9 +60,10 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         girth_tolerance: DEFAULT_GIRTH_TOLERANCE_MM,
     };
     let form = form_description::reference();
-    let (seed, out) = (args.seed, args.out.clone());
+    let (seed, out, legs) = (args.seed, args.out.clone(), args.legs.options());
     // The customer is made and scanned once the simulated form is claimed (see `shape_form`).
-    let (done, shape, truth) = shape_form(&form, &drive, &args.out, move || customer(seed, &out))?;
+    let (done, shape, truth) =
+        shape_form(&form, &drive, &args.out, move || customer(seed, &out, legs))?;
     outln!();
     outln!(
         "  {:<12} {:>9} {:>9} {:>11} {:>11}",
@@ -101,9 +105,13 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
 
 /// The synthetic customer of `seed` (the default one without), standing asymmetrically and
 /// scanned with a typical scanner's artifacts, its scan encoded as PLY into the outputs and
-/// read back; what it is and how it was scanned printed. Returns the prepared scan and the
-/// customer's true measurements.
-fn customer(seed: Option<u64>, out: &Path) -> Result<Prepared<GroundTruth>, Failure> {
+/// read back; what it is and how it was scanned printed; its mannequin built with `legs`.
+/// Returns the prepared scan and the customer's true measurements.
+fn customer(
+    seed: Option<u64>,
+    out: &Path,
+    legs: MannequinOptions,
+) -> Result<Prepared<GroundTruth>, Failure> {
     let bar = progress_bar(false, 3);
     let params = seed.map_or_else(BodyParams::default, BodyParams::random);
     let params = BodyParams { pose: asymmetric(params.pose), ..params };
@@ -156,7 +164,7 @@ fn customer(seed: Option<u64>, out: &Path) -> Result<Prepared<GroundTruth>, Fail
     );
     out!("{info}");
     outln!();
-    let reconstruct =
-        Reconstruct { model: BodyModel::builtin(), options: ReconstructOptions::default() };
+    let options = ReconstructOptions { mannequin: legs, ..Default::default() };
+    let reconstruct = Reconstruct { model: BodyModel::builtin(), options };
     Ok(Prepared { scan, reconstruct, outputs, extra: customer.truth })
 }

@@ -58,6 +58,7 @@ use dressform::body::scan::Scan;
 use dressform::body::scan::format::{Export, Format, Placement, UpAxis};
 use dressform::body::scan::frame::{Direction, FrameOptions, Units};
 use dressform::messages;
+use dressform::shape::mannequin::{LegStance, MannequinOptions, StopAt};
 use dressform::shape::symmetry::Preserve;
 use std::io::{ErrorKind, Write};
 use std::ops::{Bound, RangeBounds};
@@ -205,17 +206,56 @@ pub struct MannequinArgs {
     /// The girth every layer keeps: tape (convex hull) or contour (the paper's rule).
     #[arg(long, value_parser = preserve_parser(), default_value = Preserve::Tape.name())]
     preserve: Preserve,
+    #[command(flatten)]
+    legs: LegArgs,
 }
 
 impl MannequinArgs {
-    fn options(&self) -> dressform::shape::mannequin::MannequinOptions {
-        dressform::shape::mannequin::MannequinOptions {
+    fn options(&self) -> MannequinOptions {
+        MannequinOptions {
             torso_layers: self.torso_layers,
             leg_layers: self.leg_layers,
             rays: self.rays,
             preserve: self.preserve,
+            ..self.legs.options()
         }
     }
+}
+
+/// How the mannequin's legs stand and where they end: `symmetrize`, `reconstruct`, `run` and
+/// `demo` take these.
+#[derive(Debug, Clone, clap::Args)]
+pub struct LegArgs {
+    /// How the legs stand.
+    #[arg(long, value_parser = stance_parser(), default_value = LegStance::Straight.name())]
+    legs: LegStance,
+    /// End the form higher than the ankles: at mid-thigh, each leg closed by a flat cap.
+    #[arg(long, value_parser = stop_at_parser())]
+    stop_at: Option<StopAt>,
+}
+
+impl LegArgs {
+    /// The default mannequin's options with these legs.
+    fn options(&self) -> MannequinOptions {
+        MannequinOptions { legs: self.legs, stop_at: self.stop_at, ..Default::default() }
+    }
+}
+
+/// `--legs`: the library's [`LegStance`] by name.
+fn stance_parser() -> impl TypedValueParser<Value = LegStance> {
+    named(LegStance::ALL, LegStance::name, |s| match s {
+        LegStance::Straight => {
+            "Parallel and vertical, as a dress form's legs hang; the inseam kept"
+        }
+        LegStance::AsScanned => "As the customer stood, made symmetric",
+    })
+}
+
+/// `--stop-at`: the library's [`StopAt`] by name.
+fn stop_at_parser() -> impl TypedValueParser<Value = StopAt> {
+    named(StopAt::ALL, StopAt::name, |s| match s {
+        StopAt::Thigh => "Mid-thigh, halfway from the crotch to the knee",
+    })
 }
 
 /// How a command writes its output mesh (see [`Export`]).

@@ -9,7 +9,7 @@
 use super::drive::{ShapeArgs, SimArgs, execute, shape_verdict};
 use super::link::{FormArg, LinkArgs};
 use super::setpoints::fidelity_table;
-use super::{Failure, FrameArgs, SmoothArgs, print_warnings, progress_bar};
+use super::{Failure, FrameArgs, LegArgs, SmoothArgs, print_warnings, progress_bar};
 use dressform::atomic_output::OutputSet;
 use dressform::body::scan::{self, Scan, ScanOptions, format::Export, format::Format};
 use dressform::form::controller::{DriveOptions, LinkSpec};
@@ -48,6 +48,8 @@ pub struct RunArgs {
     frame: FrameArgs,
     #[command(flatten)]
     smooth: SmoothArgs,
+    #[command(flatten)]
+    legs: LegArgs,
 }
 
 pub fn run(args: &RunArgs) -> Result<(), Failure> {
@@ -60,13 +62,14 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     let scan_path = args.scan.clone();
     let scan_options = ScanOptions { frame: args.frame.options(), smooth: args.smooth.smooth };
     let (model_path, pose_path) = (args.model.clone(), args.pose.clone());
+    let legs = args.legs.options();
     let prepare = move || {
         let model = super::model::load(model_path.as_deref())?;
         let pose = super::reconstruct::pose_overrides(pose_path.as_deref(), &model)?;
         let scan::PreparedScan { scan, warnings, .. } =
             scan::prepare(&scan_path, &scan_options).map_err(Failure::bad_input)?;
         print_warnings(&scan.source.display().to_string(), &warnings, None);
-        let options = ReconstructOptions { pose, ..Default::default() };
+        let options = ReconstructOptions { pose, mannequin: legs, ..Default::default() };
         let reconstruct = Reconstruct { model, options };
         Ok(Prepared { scan, reconstruct, outputs: OutputSet::new(), extra: () })
     };

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 
 use form_description::FormDescription;
 
-use crate::body::regions::BodyRegions;
+use crate::body::regions::{BodyRegions, Region};
 use crate::body::scan::Scan;
 use crate::body::scan::carried::CarriedBody;
 use crate::body::scan::format::Export;
@@ -15,7 +15,7 @@ use crate::body::scan::frame::CanonicalFrame;
 use crate::body::segmented_body::SegmentedBody;
 use crate::form::form_fit::{self, FormFit, FormFitError, region_of, regions_of};
 use crate::form::setpoints::SetPoints;
-use crate::shape::mannequin::{self, Mannequin, MannequinError, MannequinOptions};
+use crate::shape::mannequin::{self, Mannequin, MannequinError, MannequinOptions, StopAt};
 use crate::shape::measure::{Comparison, compare, levels};
 use crate::shape::profiles::Profiles;
 
@@ -114,6 +114,21 @@ pub enum ShapeError {
     /// The form could not be fitted to it.
     #[error(transparent)]
     Fit(#[from] FormFitError),
+    /// A ring of the form shapes the legs below where the mannequin's end
+    /// ([`MannequinOptions::stop_at`]): it would stay retracted.
+    #[error(
+        "the form's ring {ring} shapes the legs at z = {z:.0} mm, below the mannequin's, which end at {end:.0} mm (--stop-at {stop}): build the mannequin with whole legs"
+    )]
+    BelowTheLegs {
+        /// The ring.
+        ring: String,
+        /// The mannequin height it shapes (mm).
+        z: f64,
+        /// The height of the legs' lowest layer (mm).
+        end: f64,
+        /// Where the legs were asked to end.
+        stop: &'static str,
+    },
 }
 
 /// The steps of [`shape`]: those of [`symmetrize`], then the fit.
@@ -132,9 +147,34 @@ pub fn shape(
     let symmetrized = symmetrize_segmented(&body, options, &mut progress)?;
     progress(STEPS.len());
     let fit = form_fit::fit(&symmetrized.profiles, form)?;
+    if let Some(stop) = options.stop_at {
+        check_legs_reach(&symmetrized.mannequin, form, &fit, stop)?;
+    }
     let setpoints = fit.setpoints();
     let rings = ring_girths(&body, form, &fit);
     Ok(Shaped { symmetrized, fit, setpoints, rings })
+}
+
+/// Whether the legs of `mannequin`, ended at `stop`, reach every ring of `form` that shapes
+/// them where `fit` placed it.
+fn check_legs_reach(
+    mannequin: &Mannequin,
+    form: &FormDescription,
+    fit: &FormFit,
+    stop: StopAt,
+) -> Result<(), ShapeError> {
+    let end = mannequin.left_leg.first().map_or(f64::INFINITY, |layer| layer.z);
+    let on_legs =
+        |ring: &str| form.rings.iter().any(|r| r.name == ring && region_of(r) != Region::Torso);
+    match fit.rings.iter().find(|r| on_legs(&r.ring) && r.mannequin_height_mm < end) {
+        Some(r) => Err(ShapeError::BelowTheLegs {
+            ring: r.ring.clone(),
+            z: r.mannequin_height_mm,
+            end,
+            stop: stop.name(),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// The scan's (`body`'s) and the mannequin's girths at every ring of `form` as `fit` placed

@@ -13,13 +13,17 @@
 //! shoulders, which follow the shoulder top with its own slope ([`shoulder_cap`]). Within
 //! 100 mm below the crotch the legs' mesh has rings between their layers, finer towards the
 //! crotch ([`layers`]; mesh only, as the shoulder cap's). The legs' top rings are eased into
-//! the hips above them ([`thighs`]), so the crotch join has no step.
+//! the hips above them ([`thighs`]), so the crotch join has no step. Below it the legs stand
+//! straight and parallel, as a dress form's hang, or as the customer stood ([`leg_stance`]),
+//! and reach the ankles or end at the thigh ([`form_end`]).
 //! All layers share one symmetry plane, x = `axis`: the median of the torso sections'
 //! bounding-box centres.
 
 mod arm_plates;
 mod fairing;
+mod form_end;
 mod layers;
+mod leg_stance;
 mod rebuild;
 mod shoulder_cap;
 mod shoulder_slope;
@@ -34,6 +38,9 @@ use glam::{DVec2, DVec3};
 use rebuild::TorsoRing;
 use serde::Serialize;
 
+pub use form_end::StopAt;
+pub use leg_stance::LegStance;
+
 /// How the mannequin is built.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MannequinOptions {
@@ -45,11 +52,22 @@ pub struct MannequinOptions {
     pub rays: usize,
     /// The girth each layer keeps.
     pub preserve: Preserve,
+    /// How the legs stand ([`leg_stance`]).
+    pub legs: LegStance,
+    /// Where the legs end: at the ankles (`None`) or higher ([`form_end`]).
+    pub stop_at: Option<StopAt>,
 }
 
 impl Default for MannequinOptions {
     fn default() -> Self {
-        MannequinOptions { torso_layers: 100, leg_layers: 50, rays: 360, preserve: Preserve::Tape }
+        MannequinOptions {
+            torso_layers: 100,
+            leg_layers: 50,
+            rays: 360,
+            preserve: Preserve::Tape,
+            legs: LegStance::default(),
+            stop_at: None,
+        }
     }
 }
 
@@ -189,7 +207,7 @@ pub fn build(
         });
     }
     crate::shape::symmetry::check_rays(options.rays)?;
-    let layers::SymmetricLayers { axis, mut torso, mut left_leg, mut right_leg, is_layer } =
+    let layers::SymmetricLayers { axis, mut torso, mut left_leg, mut right_leg, mut is_layer } =
         layers::symmetric_layers(body, keep, options)?;
     let landmarks = *body.landmarks();
     let own = symmetric_landmarks(&landmarks, axis);
@@ -202,6 +220,18 @@ pub fn build(
     }
     let cap = shoulder_cap::build(body.mesh(), &landmarks, &torso, axis, options)?;
     thighs::ease(&torso[0], &torso[1], &mut left_leg, &mut right_leg);
+    if options.legs == LegStance::Straight {
+        for leg in [&mut left_leg, &mut right_leg] {
+            leg_stance::straighten(leg, &is_layer, axis);
+        }
+    }
+    if let Some(stop) = options.stop_at {
+        let dropped = form_end::dropped_below(&left_leg, &is_layer, stop.height(&landmarks));
+        for rings in [&mut left_leg, &mut right_leg] {
+            rings.drain(..dropped);
+        }
+        is_layer.drain(..dropped);
+    }
     let below_cap = torso.iter().take_while(|layer| layer.z < cap.from).count();
     let mut rings = arm_plates::rims(&torso[..below_cap], axis, plates, options.preserve);
     rings.extend(cap.rings.iter().map(|ring| TorsoRing::from_rays(ring)));
