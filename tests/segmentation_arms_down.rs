@@ -2,14 +2,17 @@
 //! elbows nearly straight (issue 35): the forearms run close in front of the hips, the hands
 //! press into the front of the thighs (blend skinning lets them cross the skin). The arms must
 //! join the torso at the armpits, not where a forearm passes close to the hip, the hands must
-//! be labelled arm, and the waist must not take in the forearms.
+//! be labelled arm, the waist must not take in the forearms, and `measure` and `reconstruct`
+//! must work on the scan file.
 
 use crate::common::{self, frontal::abduction};
 use dressform::body::mesh::Mesh;
 use dressform::body::regions::Region;
 use dressform::body::scan::{self, format::Format, frame::FrameOptions};
 use dressform::body::segmented_body::SegmentedBody;
+use dressform::pose::body_model::BodyModel;
 use dressform::pose::makehuman::{MakeHuman, Pose};
+use dressform::run::reconstruct::{ReconstructOptions, reconstruct};
 use dressform::shape::measure::{levels, measure_at};
 use glam::DVec3;
 use std::path::Path;
@@ -26,6 +29,9 @@ const BUILD: &str = "macrodetails/universal-female-young-averagemuscle-maxweight
 /// How far the waist may differ from the same body's in the A-pose (mm): the arms' pose moves
 /// the soft tissue a little; a forearm taken in adds 250 mm or more.
 const WAIST_TOLERANCE_MM: f64 = 5.0;
+/// How far the pose-symmetric scan's armpits may lie from the scan's (mm): the arms stay down,
+/// and re-posing moves the body by the feet's drop (a few millimetres).
+const REPOSED_ARMPIT_MM: f64 = 15.0;
 /// Taubin passes before segmenting, as `measure` does by default.
 const SMOOTHING_PASSES: usize = 8;
 
@@ -95,6 +101,21 @@ fn both_arms_hanging_with_the_hands_on_the_thighs_segment_at_the_armpits() {
         assert_eq!(holding.map(|k| labels[k]), Some(arm), "{side} wrist at {wrist:.0}");
     }
     let waist = measure_at(&found, &levels(&found)).waist.tape;
+
+    // `reconstruct`: the pose-symmetric scan keeps the arms down, and segments alike.
+    let scan = scan::load(&file, &FrameOptions::default()).unwrap();
+    let rec = reconstruct(&scan, &BodyModel::builtin(), &ReconstructOptions::default(), |_| {})
+        .expect("reconstruct with both arms down");
+    let symmetric = rec.result.regions.landmarks;
+    for (side, z, found) in [
+        ("left", symmetric.left_armpit, lm.left_armpit),
+        ("right", symmetric.right_armpit, lm.right_armpit),
+    ] {
+        assert!(
+            (z - found).abs() <= REPOSED_ARMPIT_MM,
+            "{side} armpit of the pose-symmetric scan at {z:.0} mm, the scan's at {found:.0}"
+        );
+    }
     println!(
         "arms down: armpits {:.0} / {:.0} mm; waist {waist:.0} mm (A-pose {rest_waist:.0})",
         lm.left_armpit, lm.right_armpit
