@@ -35,6 +35,7 @@ mod pose_symmetry_proportions;
 mod preview;
 mod run_end_to_end;
 mod segmentation;
+mod segmentation_arms_down;
 mod segmentation_makehuman;
 mod segmentation_stances;
 mod sim_cli;

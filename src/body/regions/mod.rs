@@ -257,7 +257,7 @@ impl BodyRegions {
     }
 
     /// Labels for the loops of `section` (cut from the same body at any height): each loop
-    /// takes the label of the tracked loop that holds its centroid (or, failing that, the
+    /// takes the label of the innermost tracked loop that holds its centroid (or, failing that, the
     /// nearest tracked centroid) at the nearest tracked level between the same landmarks, so
     /// that a cut just below the crotch or an armpit is never labelled from a level above it.
     pub fn label(&self, section: &Section) -> Vec<Region> {
@@ -287,7 +287,10 @@ impl BodyRegions {
             .map(|l| {
                 let c = l.centroid();
                 let tracked = &level.section.loops;
-                let inside = (0..tracked.len()).find(|&k| tracked[k].contains(c));
+                // The innermost loop holding it: a hand pressed into the hip or thigh may
+                // cross the skin there (a posed mesh's blend skinning does), its loop then
+                // lying inside the torso's.
+                let inside = (0..tracked.len()).rev().find(|&k| tracked[k].contains(c));
                 let nearest = || {
                     (0..tracked.len()).min_by(|&a, &b| {
                         let da = tracked[a].centroid().distance_squared(c);

@@ -317,7 +317,15 @@ fn arm_join(
             .filter(|&k| k != t)
             .filter(|&k| sign * (sections[i].loops[k].centroid().x - centre) > 0.0);
         let arm_loop_here = beside.clone().next().is_some();
-        let joined = beside.find(|&k| overlaps(&sections[i].loops[k], next)).map(Join::Loop);
+        // Joined: the arm's loop overlaps the torso's next loop and is continued by it, not
+        // by a loop of its own (an arm running close beside the torso, in front of the hip,
+        // overlaps it seen from above without touching it).
+        let joined = beside
+            .find(|&k| {
+                let arm = &sections[i].loops[k];
+                overlaps(arm, next) && continuing(&sections[j], arm) == Some(t_next)
+            })
+            .map(Join::Loop);
         // An arm whose own loop is still beside the torso joins as that loop (its blend may
         // widen the torso's loop first); only an arm with none below grows out.
         let grown =
