@@ -174,8 +174,7 @@ fn body(mh: &MakeHuman, population: &population::Population, index: usize) -> Bo
         |side: &str, from_hanging: f64| turn_out("upperarm01", side, from_hanging - arm_rest(side));
     let sign: f64 = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
     let mut pose = Vec::new();
-    let summary;
-    match stance {
+    let summary = match stance {
         Stance::Slight => {
             let (arm, clavicle, leg) = (
                 rng.random_range(10.0..20.0),
@@ -191,32 +190,32 @@ fn body(mh: &MakeHuman, population: &population::Population, index: usize) -> Bo
                 pose.push((bone.to_string(), DVec3::Y * (bend / 2.0).to_radians()));
             }
             pose.push(("head".to_string(), DVec3::Z * (head * sign).to_radians()));
-            summary = format!(
+            format!(
                 "arm{one} +{arm:.0} clav +{clavicle:.0} leg{other} +{leg:.0} bend {bend:+.0} head {:+.0}",
                 head * sign
-            );
+            )
         }
         Stance::ArmsDown => {
             let (a, b) = (rng.random_range(0.0..5.0), rng.random_range(0.0..5.0));
             pose.extend([arm_to(".L", a), arm_to(".R", b)]);
-            summary = format!("arms at {a:.0}/{b:.0} from hanging");
+            format!("arms at {a:.0}/{b:.0} from hanging")
         }
         Stance::ArmUp => {
             let a = rng.random_range(80.0..90.0);
             pose.push(arm_to(one, a));
-            summary = format!("arm{one} at {a:.0} from hanging");
+            format!("arm{one} at {a:.0} from hanging")
         }
         Stance::ArmsApart => {
             let (a, b) = (rng.random_range(0.0..5.0), rng.random_range(80.0..90.0));
             pose.extend([arm_to(one, a), arm_to(other, b)]);
-            summary = format!("arm{one} at {a:.0}, arm{other} at {b:.0} from hanging");
+            format!("arm{one} at {a:.0}, arm{other} at {b:.0} from hanging")
         }
         Stance::Twist => {
             let twist = 10.0 * sign;
             for bone in ["spine03", "spine02"] {
                 pose.push((bone.to_string(), DVec3::Z * (twist / 2.0).to_radians()));
             }
-            summary = format!("spine twist {twist:+.0}");
+            format!("spine twist {twist:+.0}")
         }
         Stance::LegsTogether => {
             // In by most of the rest stance: the thighs touch, the shins stay apart.
@@ -224,9 +223,9 @@ fn body(mh: &MakeHuman, population: &population::Population, index: usize) -> Bo
             for side in [".L", ".R"] {
                 pose.push(turn_out("upperleg01", side, -share * leg_rest(side)));
             }
-            summary = format!("legs in by {:.0}% of rest", share * 100.0);
+            format!("legs in by {:.0}% of rest", share * 100.0)
         }
-    }
+    };
     Body { index, stance, recipe, symmetric: symmetric(&pose), pose, summary }
 }
 
