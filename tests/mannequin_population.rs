@@ -7,7 +7,11 @@
 //! body un-posed, its true shape: girths at the true body's chest, waist and hip levels, the
 //! width jump over the whole height, self-intersections, the legs' axes.
 //!
-//! `DRESSFORM_POPULATION=N` runs the first N of the 40 (CI runs [`CI_BODIES`]);
+//! The issue's acceptance is asserted as a ratchet ([`KNOWN_MISSES`]): what misses it today is
+//! listed, anything else fails, and a listed miss that now holds must be taken off.
+//!
+//! `DRESSFORM_POPULATION=N` runs the first N of the 40 (the population's bias is checked only
+//! on all 40); `DRESSFORM_POPULATION_DIAG=1` also reconstructs each body scanned un-posed;
 //! `DRESSFORM_LOOK=<dir>` writes each body's scan, truth and mannequin as OBJ for
 //! `../shared/tools/look.py`.
 
@@ -43,8 +47,53 @@ const STATURE_MM: (f64, f64) = (1550.0, 1950.0);
 const SEED: u64 = 35;
 /// How many bodies the issue asks for, half slightly posed and half in hard stances.
 const BODIES: usize = 40;
-/// How many CI runs: every third of the 40, both families alike.
-const CI_BODIES: usize = 14;
+
+/// The issue's acceptance: chest, waist and hip at the un-posed body's levels within these
+/// (mm) on the slightly posed bodies and on the hard stances;
+const GIRTH_TOLERANCE_MM: [f64; 2] = [5.0, 10.0];
+/// no sign bias: each girth's mean error over the population within this (mm);
+const BIAS_TOLERANCE_MM: f64 = 2.0;
+/// the width of the mannequin never jumping more than this between sections 2 mm apart (mm);
+const WIDTH_JUMP_MM: f64 = 15.0;
+/// both legs' axes within this of vertical (degrees, the default straight legs).
+const LEG_AXIS_DEG: f64 = 1.0;
+/// A listed miss counts as mended only when it holds by this much (mm or degrees), so that a
+/// value at the tolerance (a library's re-meshing a hair different) does not flap the list.
+const MENDED_MARGIN: f64 = 0.5;
+
+/// What the acceptance checks on each body, and on the population's mean.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Check {
+    Reconstructs,
+    Chest,
+    Waist,
+    Hip,
+    WidthJump,
+    Intersections,
+    Legs,
+    ChestBias,
+    WaistBias,
+    HipBias,
+}
+
+/// The acceptance's misses today, as (body, check); a bias check is keyed by [`BODIES`] and
+/// checked only when all of them run. The test fails on a miss not listed and on a listed one
+/// that now holds by [`MENDED_MARGIN`]: the list only shrinks, and each mend must take its
+/// entries off.
+const KNOWN_MISSES: &[(usize, Check)] = &[
+    // Both arms hanging: the armpits found 20-70 mm low on the re-posed scan, a ledge under
+    // the arm plates (28 mm).
+    (20, Check::WidthJump),
+    (35, Check::WidthJump),
+    // One arm hanging, the other near horizontal: the fit does not converge (22, 37: "the
+    // right leg is 561-578 mm from it"), or the hanging arm stays fused with the torso (32:
+    // fins at the armpit).
+    (22, Check::Reconstructs),
+    (32, Check::Chest),
+    (32, Check::WidthJump),
+    (32, Check::Intersections),
+    (37, Check::Reconstructs),
+];
 
 /// The stances of the population.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -70,34 +119,8 @@ struct Body {
     stance: Stance,
     recipe: Vec<(String, f64)>,
     pose: Vec<(String, DVec3)>,
-    /// The same body with each pair of limbs at the mean of its two sides and the spine and
-    /// head straight: what pose symmetry should make of it.
-    symmetric: Vec<(String, DVec3)>,
     /// What the pose is, for the table.
     summary: String,
-}
-
-/// `pose` made symmetric: each limb bone at the mean of its two sides' outward turns, the
-/// midline bones (spine, head) at rest.
-fn symmetric(pose: &[(String, DVec3)]) -> Vec<(String, DVec3)> {
-    let out = |bone: &str, side: &str| {
-        pose.iter()
-            .find(|(b, _)| *b == format!("{bone}{side}"))
-            .map_or(0.0, |(_, t)| t.y * outward(side))
-    };
-    let mut bones: Vec<&str> =
-        pose.iter().filter_map(|(b, _)| b.strip_suffix(".L").or(b.strip_suffix(".R"))).collect();
-    bones.dedup();
-    bones.sort();
-    bones.dedup();
-    let mut symmetric = Vec::new();
-    for bone in bones {
-        let mean = 0.5 * (out(bone, ".L") + out(bone, ".R"));
-        for side in [".L", ".R"] {
-            symmetric.push((format!("{bone}{side}"), DVec3::Y * outward(side) * mean));
-        }
-    }
-    symmetric
 }
 
 /// The side's outward turn about Y: the left limbs turn out about -Y, the right about +Y.
@@ -226,15 +249,13 @@ fn body(mh: &MakeHuman, population: &population::Population, index: usize) -> Bo
             format!("legs in by {:.0}% of rest", share * 100.0)
         }
     };
-    Body { index, stance, recipe, symmetric: symmetric(&pose), pose, summary }
+    Body { index, stance, recipe, pose, summary }
 }
 
-/// The indices this run checks: all 40 with `DRESSFORM_POPULATION=40`, else every third.
+/// The indices this run checks: all 40, or the first N with `DRESSFORM_POPULATION=N`.
 fn chosen() -> Vec<usize> {
-    match std::env::var("DRESSFORM_POPULATION").ok().and_then(|n| n.parse::<usize>().ok()) {
-        Some(n) => (0..n.min(BODIES)).collect(),
-        None => (0..BODIES).step_by(BODIES.div_ceil(CI_BODIES)).collect(),
-    }
+    let n = std::env::var("DRESSFORM_POPULATION").ok().and_then(|n| n.parse::<usize>().ok());
+    (0..n.unwrap_or(BODIES).min(BODIES)).collect()
 }
 
 /// A leg's axis angles from vertical (degrees): sideways (x) and forwards (y), by a least-
@@ -253,6 +274,7 @@ fn leg_axis(layers: &[Layer]) -> [f64; 2] {
 
 /// What one body gave.
 struct Row {
+    index: usize,
     stance: Stance,
     line: String,
     /// Chest, waist and hip error (mm, mannequin minus truth at the truth's levels).
@@ -264,15 +286,10 @@ struct Row {
 }
 
 /// The truth: the body un-posed, clean, in the canonical frame.
-/// With `bones`, the truth posed so (clean, the diagnosis's `G_ts`).
-fn truth(mh: &MakeHuman, body: &Body, bones: &[(String, DVec3)]) -> Scan {
+fn truth(mh: &MakeHuman, body: &Body) -> Scan {
     let refs: Vec<(&str, f64)> = body.recipe.iter().map(|(t, w)| (t.as_str(), *w)).collect();
-    let skin = posed(mh, &mh.shaped(&refs).unwrap(), bones);
+    let skin = posed(mh, &mh.shaped(&refs).unwrap(), &[]);
     from_mesh(skin, Path::new("truth"), &Default::default()).unwrap()
-}
-
-fn truth_posed(mh: &MakeHuman, body: &Body) -> Scan {
-    truth(mh, body, &body.symmetric)
 }
 
 fn check(
@@ -283,14 +300,14 @@ fn check(
     rest: Option<&Scan>,
     look: Option<&Path>,
 ) -> Row {
-    let truth = truth(mh, body, &[]);
-    let in_symmetric_pose = truth_posed(mh, body);
+    let truth = truth(mh, body);
     let segmented = SegmentedBody::find(&truth.body).unwrap();
     let marks = segmented.landmarks();
     let at = levels(&segmented);
     let z = [at.chest, at.waist, at.hip];
     let want = girths(&truth.body, 0.0, &z);
     let mut row = Row {
+        index: body.index,
         stance: body.stance,
         line: format!(
             "{:2} {:<12} {:>4.0} mm {:<52}",
@@ -316,8 +333,6 @@ fn check(
     let m = &rec.result.mannequin;
     let got = girths(&m.mesh, m.axis, &z);
     let posed = girths(&rec.reposed.posed.body, m.axis, &z);
-    let symmetric = girths(&in_symmetric_pose.body, 0.0, &z);
-    let symmetric_crotch = SegmentedBody::find(&in_symmetric_pose.body).unwrap().landmarks().crotch;
     let own = m.own_landmarks();
     let d_crotch = own.crotch - marks.crotch;
     let shifted: Vec<f64> = z.iter().map(|z| z + d_crotch).collect();
@@ -331,13 +346,11 @@ fn check(
     row.legs_deg = legs.iter().flatten().fold(0.0_f64, |a, b| a.max(b.abs()));
     let diff = |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(a, b)| a - b).collect() };
     row.line += &format!(
-        " | truth {want:.0?} err {:+.1?} posed {:+.1?} sym-truth {:+.1?} at-crotch {:+.1?} | dcrotch {d_crotch:+.1} posed {:+.1} sym {:+.1} darmpit {:+.1} | jump {:.1} x {} legs {:.1?}",
+        " | truth {want:.0?} err {:+.1?} posed {:+.1?} at-crotch {:+.1?} | dcrotch {d_crotch:+.1} posed {:+.1} darmpit {:+.1} | jump {:.1} x {} legs {:.1?}",
         row.girth_error,
         diff(&posed, &want),
-        diff(&symmetric, &want),
         diff(&got_shifted, &want),
         rec.result.regions.landmarks.crotch - marks.crotch,
-        symmetric_crotch - marks.crotch,
         own.left_armpit.min(own.right_armpit) - marks.left_armpit.min(marks.right_armpit),
         row.width_jump,
         row.intersections,
@@ -410,13 +423,7 @@ fn scan_all(mh: &MakeHuman, python: &str, tmp: &Path, jobs: &[(&Body, &str)]) ->
 #[test]
 fn mannequins_of_varied_bodies_match_their_unposed_truth() {
     let Some(dir) = common::makehuman() else { return };
-    let Some(python) = common::or_skip(
-        remesher(),
-        "python3 with trimesh, scipy, scikit-image",
-        "DRESSFORM_REQUIRE_PEERS",
-    ) else {
-        return;
-    };
+    let Some(python) = remesher() else { return };
     let mh = MakeHuman::load(&dir).expect("the MakeHuman assets load");
     let model = BodyModel::builtin();
     let population = population::sample(BODIES, SEED);
@@ -478,4 +485,56 @@ fn mannequins_of_varied_bodies_match_their_unposed_truth() {
             errors.iter().map(|r| r.legs_deg).fold(0.0, f64::max),
         );
     }
+
+    let run: Vec<usize> = rows.iter().map(|r| r.index).collect();
+    let found = misses(&rows, 0.0);
+    let holding = misses(&rows, MENDED_MARGIN);
+    let known: Vec<(usize, Check)> = KNOWN_MISSES
+        .iter()
+        .filter(|(i, _)| run.contains(i) || run.len() == BODIES)
+        .copied()
+        .collect();
+    let new: Vec<_> = found.iter().filter(|m| !known.contains(m)).collect();
+    let mended: Vec<_> = known.iter().filter(|m| !holding.contains(m)).collect();
+    assert!(
+        new.is_empty() && mended.is_empty(),
+        "issue 35's acceptance: new misses {new:?}; mended, take them off KNOWN_MISSES: {mended:?}"
+    );
+}
+
+/// The acceptance's misses over `rows`, each tolerance tightened by `margin`.
+fn misses(rows: &[Row], margin: f64) -> Vec<(usize, Check)> {
+    let mut out = Vec::new();
+    for r in rows {
+        if r.failed.is_some() {
+            out.push((r.index, Check::Reconstructs));
+            continue;
+        }
+        let tolerance = GIRTH_TOLERANCE_MM[usize::from(r.stance != Stance::Slight)] - margin;
+        for (k, check) in [Check::Chest, Check::Waist, Check::Hip].into_iter().enumerate() {
+            if r.girth_error[k].abs() > tolerance {
+                out.push((r.index, check));
+            }
+        }
+        if r.width_jump > WIDTH_JUMP_MM - margin {
+            out.push((r.index, Check::WidthJump));
+        }
+        if r.intersections > 0 {
+            out.push((r.index, Check::Intersections));
+        }
+        if r.legs_deg > LEG_AXIS_DEG - margin {
+            out.push((r.index, Check::Legs));
+        }
+    }
+    if rows.len() < BODIES {
+        return out;
+    }
+    let built: Vec<&Row> = rows.iter().filter(|r| r.failed.is_none()).collect();
+    for (k, check) in [Check::ChestBias, Check::WaistBias, Check::HipBias].into_iter().enumerate() {
+        let mean = built.iter().map(|r| r.girth_error[k]).sum::<f64>() / built.len() as f64;
+        if mean.abs() > BIAS_TOLERANCE_MM - margin {
+            out.push((BODIES, check));
+        }
+    }
+    out
 }

@@ -7,18 +7,27 @@
 //! rotation `R` into `M R M`, whose vector is `det(M) M w`). So the symmetric pose is:
 //! - a bone on the midline (root, spine, neck, head) keeps only its turn about X, the forward
 //!   bend: its sideways bend (about Y) and its twist or turn (about Z) go to zero;
-//! - a left/right pair (arms, legs) stands, as the paper does ([`Limbs::Mean`], the default),
-//!   at the mean of the left angle and the mirrored right one, the right bone the mirror of
-//!   that mean; or (`limbs = "rest"` in a pose file, [`Limbs::Rest`]) at the body model's rest:
-//!   the same stance for every customer however they stood, and the stance the model's shapes
-//!   and weights come from (MakeHuman's rest: arms 40 degrees out, legs 8).
+//! - a left/right pair (arms, legs) stands at the body model's rest in the frontal plane and
+//!   untwisted ([`Limbs::Rest`], the default): the same stance for every customer however
+//!   they stood, and the stance the model's shapes and weights come from (MakeHuman's rest:
+//!   arms 40 degrees out, legs 8); its forward bend (about X: a hip flexed against a pelvis
+//!   tilted forward, a knee, an arm swung) is the mean of the two sides', as the midline
+//!   keeps its own. Or, as the paper does (`limbs = "mean"` in a pose file, [`Limbs::Mean`]),
+//!   the whole rotation is the mean of the left angle and the mirrored right one, the right
+//!   bone the mirror of that mean.
 //!
-//! Why the rest is offered (and is the candidate default, issue 35): the torso's shape under the arms and its height
-//! above the floor follow the limbs. On 4 MakeHuman bodies standing slightly asymmetric (an arm
+//! Why not the paper's mean (issue 35): the torso's shape under the arms and its height above
+//! the floor follow the limbs. On 4 MakeHuman bodies standing slightly asymmetric (an arm
 //! 11-17 degrees further out, a leg 3-8), the mean stance put the pose-symmetric scan's chest
 //! +7 to +16 mm over the same body un-posed at its chest level (the arms further out stretch the
 //! skin under them; the legs further out lower the crotch 4-8 mm), the waist up to -13; at the
-//! rest stance the waist and hip came within 1 mm (`tests/mannequin_population.rs`, issue 35).
+//! rest stance the waist and hip came within 1 mm (`tests/mannequin_population.rs`).
+//!
+//! Why the forward bend is kept: the fit shares a body's upright stance between its pelvis
+//! and its thighs (on one MakeHuman body standing at rest: the pelvis tilted 2.2 degrees
+//! forward, both hips 2.5 back). Setting the thighs to rest while the pelvis keeps its tilt
+//! leant the whole torso forward, and a level tape round a leant chest is longer or shorter:
+//! the chest of 20 slightly posed bodies came out -14 to +11 mm off.
 //!
 //! A `pose.toml` ([`PoseOverrides`]) then sets any named joint; the re-posed scan is the scan
 //! moved, bone by bone, from the fitted pose to that one ([`repose`]).
@@ -44,9 +53,9 @@ pub fn mirror(theta: DVec3) -> DVec3 {
 #[serde(rename_all = "lowercase")]
 pub enum Limbs {
     /// At the body model's rest: the same stance for every scan.
+    #[default]
     Rest,
     /// At the mean of the two sides (the paper's).
-    #[default]
     Mean,
 }
 
@@ -56,11 +65,13 @@ pub fn symmetric(theta: &[DVec3], skeleton: &Skeleton, limbs: Limbs) -> Vec<DVec
     let partner = skeleton.mirror();
     let mean = |b: usize| (theta[b] + mirror(theta[partner[b]])) / 2.0;
     (0..theta.len())
-        .map(|b| match (partner[b] == b, limbs) {
-            (false, Limbs::Rest) => DVec3::ZERO,
+        .map(|b| {
             // The second bone of a pair takes the mirror of the first's mean: exactly symmetric.
-            _ if partner[b] < b => mirror(mean(partner[b])),
-            _ => mean(b),
+            let m = if partner[b] < b { mirror(mean(partner[b])) } else { mean(b) };
+            match (partner[b] == b, limbs) {
+                (false, Limbs::Rest) => DVec3::new(m.x, 0.0, 0.0),
+                _ => m,
+            }
         })
         .collect()
 }
@@ -182,19 +193,21 @@ mod tests {
         let theta = [
             DVec3::new(0.1, 0.2, 0.3),
             DVec3::new(-0.2, 0.1, -0.1),
-            DVec3::new(0.0, -0.4, 0.0),
-            DVec3::new(0.0, 0.2, 0.0),
+            DVec3::new(0.1, -0.4, 0.0),
+            DVec3::new(0.3, 0.2, 0.0),
         ];
         let sym = symmetric(&theta, &s, Limbs::Mean);
         assert!(sym[0].distance(DVec3::new(0.1, 0.0, 0.0)) < 1e-12, "{}", sym[0]);
         assert!(sym[1].distance(DVec3::new(-0.2, 0.0, 0.0)) < 1e-12, "{}", sym[1]);
-        // Left arm down by 0.4, the right (mirrored) by 0.2: both at 0.3.
-        assert!(sym[2].distance(DVec3::new(0.0, -0.3, 0.0)) < 1e-12, "{}", sym[2]);
+        // Left arm down by 0.4, the right (mirrored) by 0.2: both at 0.3; swung 0.1 and 0.3
+        // forward: both 0.2.
+        assert!(sym[2].distance(DVec3::new(0.2, -0.3, 0.0)) < 1e-12, "{}", sym[2]);
         assert_eq!(sym[3], mirror(sym[2]));
-        // At rest the arms stand as the model's rest, the midline as with the mean.
+        // At rest the arms stand as the model's rest but for their mean forward swing, the
+        // midline as with the mean.
         let rest = symmetric(&theta, &s, Limbs::Rest);
         assert_eq!(rest[..2], sym[..2]);
-        assert_eq!(rest[2..], [DVec3::ZERO; 2]);
+        assert_eq!(rest[2..], [DVec3::new(sym[2].x, 0.0, 0.0); 2]);
     }
 
     #[test]
@@ -202,9 +215,9 @@ mod tests {
         let s = skeleton();
         let o = PoseOverrides::parse("[joints]\n\"arm.L\" = [0, -30, 0]\n", Path::new("p"), &s)
             .unwrap();
-        assert_eq!(o.limbs, Limbs::Mean);
-        let mean = PoseOverrides::parse("limbs = \"rest\"\n", Path::new("p"), &s).unwrap();
-        assert_eq!((mean.limbs, mean.joints.len()), (Limbs::Rest, 0));
+        assert_eq!(o.limbs, Limbs::Rest);
+        let mean = PoseOverrides::parse("limbs = \"mean\"\n", Path::new("p"), &s).unwrap();
+        assert_eq!((mean.limbs, mean.joints.len()), (Limbs::Mean, 0));
         let mut theta = vec![DVec3::ZERO; 4];
         o.apply(&mut theta, &s);
         assert!((theta[2].y + 30f64.to_radians()).abs() < 1e-12);

@@ -287,10 +287,13 @@ impl BodyRegions {
             .map(|l| {
                 let c = l.centroid();
                 let tracked = &level.section.loops;
-                // The innermost loop holding it: a hand pressed into the hip or thigh may
+                // The innermost outline holding it: a hand pressed into the hip or thigh may
                 // cross the skin there (a posed mesh's blend skinning does), its loop then
-                // lying inside the torso's.
-                let inside = (0..tracked.len()).rev().find(|&k| tracked[k].contains(c));
+                // lying inside the torso's. A hole (clockwise: thighs touching below the
+                // crotch enclose one) is no part of its own and is passed over.
+                let inside = (0..tracked.len())
+                    .rev()
+                    .find(|&k| tracked[k].signed_area() > 0.0 && tracked[k].contains(c));
                 let nearest = || {
                     (0..tracked.len()).min_by(|&a, &b| {
                         let da = tracked[a].centroid().distance_squared(c);
