@@ -9,8 +9,10 @@ use super::params::{Params, PreparedModel, vertex_normals};
 use glam::{DQuat, DVec3};
 
 /// The abductions tried for each arm (degrees outwards from the current angle): the scanning
-/// poses the paper and issue 15 cover put an arm between the A-pose and 60 degrees further out.
-pub const ARM_STARTS_DEG: [f64; 6] = [-15.0, 0.0, 15.0, 30.0, 45.0, 60.0];
+/// poses the paper and issue 15 cover put an arm between the A-pose and 60 degrees further out;
+/// issue 35's hard stances hang an arm 0-5 degrees from the body (the model's rest arm is 40
+/// out).
+pub const ARM_STARTS_DEG: [f64; 7] = [-35.0, -15.0, 0.0, 15.0, 30.0, 45.0, 60.0];
 
 /// The upper arms and the sign that turns each outwards about +Y (the skinning convention: a
 /// positive turn about +Y brings the left arm down).

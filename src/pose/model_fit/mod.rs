@@ -199,7 +199,11 @@ pub fn fit(
     let mut last = None;
     for (s, stage) in options.stages.iter().enumerate() {
         let active = active(&prep, stage.bones);
-        if stage.bones != Bones::Global && s > 0 && options.stages[s - 1].bones == Bones::Global {
+        // The arms' starts before the global placement too: placed with both arms at rest, a
+        // body with one arm hanging and the other near horizontal tilted the whole model 33
+        // degrees sideways to lay its arms along the scan's, and its legs never came back.
+        let first = s == 0;
+        if first || (stage.bones != Bones::Global && options.stages[s - 1].bones == Bones::Global) {
             params = arm_starts::best(&prep, &cloud, params, stage.sigma_mm);
         }
         let mut lambda = lm::LAMBDA_START;
