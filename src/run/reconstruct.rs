@@ -4,6 +4,7 @@
 //! of the pose-symmetric scan: the mannequin alone ([`reconstruct`], for `reconstruct`) or the
 //! mannequin with the form fitted to it ([`reconstruct_shape`], for `run` and `demo`).
 
+use crate::body::mesh::Mesh;
 use crate::body::regions::BodyRegions;
 use crate::body::scan::Scan;
 use crate::body::segmented_body::SegmentedBody;
@@ -157,6 +158,7 @@ pub fn repose(
     );
     let mut posed = scan.clone();
     posed.body.positions = moved;
+    tear_fused_skin(&body.positions, &mut posed.body);
     // The symmetric legs stand a little higher or lower: the body moved so that its feet stand
     // where the scan's did, the move recorded in the frame (so `--scan-frame` writes it back
     // where the scan stood).
@@ -164,6 +166,35 @@ pub fn repose(
     posed.frame.translate(&mut posed.body, DVec3::Z * drop);
     posed.frame.centre_on_torso(&mut posed.body);
     Ok(Reposed { model: extended, fit: fitted, symmetric, residuals, rig, posed, fit_seconds })
+}
+
+/// How many times its scanned length an edge of the re-posed scan may be stretched: where two
+/// parts touched as the customer stood (an arm hanging against the torso) the scan's surface
+/// joins them, and re-posing pulls that join out into a web between the arm and the torso
+/// (on MakeHuman bodies with both arms 0-5 degrees from hanging: webs down to 40-70 mm below
+/// the armpit, ledges on the mannequin). Chosen on issue 35's 40 MakeHuman bodies: at 4 the
+/// webs stayed; at 3 two of the three bodies with webs kept ledges (width jumps 28 and 21 mm);
+/// at 2 one kept a lip; the slightly posed bodies' girths did not move at any of them.
+const TORN_STRETCH: f64 = 2.0;
+/// Edges shorter than this as scanned (mm) count as this long: a sliver's stretch means nothing.
+const TORN_MIN_EDGE_MM: f64 = 1.0;
+
+/// Drops the triangles of `mesh` (the re-posed scan) any of whose edges stretched more than
+/// [`TORN_STRETCH`] times from `scanned` (the same vertices as scanned): the web is cut open,
+/// leaving a hole as a scanner's, which slicing bridges. The vertices stay (the rig's weights
+/// are per vertex).
+fn tear_fused_skin(scanned: &[DVec3], mesh: &mut Mesh) {
+    let stretched = |a: u32, b: u32| {
+        let before = scanned[a as usize].distance(scanned[b as usize]).max(TORN_MIN_EDGE_MM);
+        mesh.positions[a as usize].distance(mesh.positions[b as usize]) > TORN_STRETCH * before
+    };
+    let kept: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .copied()
+        .filter(|&[a, b, c]| !(stretched(a, b) || stretched(b, c) || stretched(c, a)))
+        .collect();
+    mesh.triangles = kept;
 }
 
 /// Measures `scan` (canonical frame) as it stands, where it can be segmented so: the column
