@@ -52,7 +52,8 @@ pub fn mirror(theta: DVec3) -> DVec3 {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Limbs {
-    /// At the body model's rest: the same stance for every scan.
+    /// At the body model's rest, sideways and in twist (the same stance for every scan); the
+    /// forward bend the mean of the two sides'.
     #[default]
     Rest,
     /// At the mean of the two sides (the paper's).

@@ -184,17 +184,12 @@ const TORN_MIN_EDGE_MM: f64 = 1.0;
 /// leaving a hole as a scanner's, which slicing bridges. The vertices stay (the rig's weights
 /// are per vertex).
 fn tear_fused_skin(scanned: &[DVec3], mesh: &mut Mesh) {
+    let positions = &mesh.positions;
     let stretched = |a: u32, b: u32| {
         let before = scanned[a as usize].distance(scanned[b as usize]).max(TORN_MIN_EDGE_MM);
-        mesh.positions[a as usize].distance(mesh.positions[b as usize]) > TORN_STRETCH * before
+        positions[a as usize].distance(positions[b as usize]) > TORN_STRETCH * before
     };
-    let kept: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .copied()
-        .filter(|&[a, b, c]| !(stretched(a, b) || stretched(b, c) || stretched(c, a)))
-        .collect();
-    mesh.triangles = kept;
+    mesh.triangles.retain(|&[a, b, c]| !(stretched(a, b) || stretched(b, c) || stretched(c, a)));
 }
 
 /// Measures `scan` (canonical frame) as it stands, where it can be segmented so: the column
