@@ -5,12 +5,14 @@
 
 mod adjacency;
 mod components;
+mod grow;
 pub mod reduce;
 pub mod smooth;
 mod topology;
 mod weld;
 
 pub use components::{Component, Components, NO_PIECE, components};
+pub use grow::grow;
 pub use topology::{Topology, topology};
 
 use glam::DVec3;
