@@ -5,12 +5,13 @@
 use capture_sim::{BodyParams, generate};
 use dressform::body::mesh::Mesh;
 use dressform::body::scan::{self, frame::FrameOptions};
-use dressform::form::form_fit::fit;
+use dressform::form::form_fit::{Placement, RingStatus, fit, fit_by};
 use dressform::run::pipeline::symmetrize;
 use dressform::shape::mannequin::MannequinOptions;
 use dressform::shape::profiles::Profiles;
 use form_description::reference;
 use glam::DVec3;
+use rayon::prelude::*;
 use std::path::Path;
 
 fn profiles_of(params: &BodyParams) -> Profiles {
@@ -41,7 +42,8 @@ fn customers_inside_the_range_are_matched_within_2_mm_at_every_ring() {
         BodyParams::default(),
         BodyParams { height_mm: 1640.0, leg_length_mm: 760.0, ..BodyParams::default() },
     ] {
-        let fit = fit(&profiles_of(&params), &reference()).unwrap();
+        let form = reference();
+        let fit = fit(&profiles_of(&params), &form).unwrap();
         assert_within_strokes(&fit);
         for ring in &fit.rings {
             assert!(
@@ -57,14 +59,12 @@ fn customers_inside_the_range_are_matched_within_2_mm_at_every_ring() {
                 ring.mannequin_girth_mm
             );
             // The girth is met; where the section's shape differs from the ring's panel layout
-            // (a flat back, a slim abdomen in a deep ring), a panel rests off the mannequin by a
-            // few millimetres, and the report says where.
-            assert!(
-                ring.largest_radial_gap_mm < 15.0,
-                "{}: gap {:.1}",
-                ring.ring,
-                ring.largest_radial_gap_mm
-            );
+            // (a flat back, a bust, a section wider than deep), the least squares leave panels
+            // off the mannequin (up to 31 mm inside at the hip's front, so that the sides and
+            // the back follow it at that girth), and the report gives every panel's gap.
+            let panels = form.actuators.iter().filter(|a| a.ring == ring.ring);
+            assert!(panels.clone().all(|a| ring.panel_gaps_mm.contains_key(&a.id)));
+            assert_eq!(panels.count(), ring.panel_gaps_mm.len());
         }
         // Anchored rings sit on their levels: chest, waist, hip at offset 0 from their level.
         for name in ["chest", "waist", "hip"] {
@@ -106,4 +106,52 @@ fn a_customer_beyond_the_forms_range_is_reported_and_clamped() {
 
 fn arm(abduction: f64) -> capture_sim::ArmPose {
     capture_sim::ArmPose { abduction_deg: abduction, ..capture_sim::Pose::a_pose().left_arm }
+}
+
+/// The least-squares placement against the common offset (each panel's centre on the section,
+/// all moved out by one offset to the girth) on 20 random customers (1.55-1.95 m): at every
+/// ring whose girth the form takes, the girth is exact both ways and the skin's RMS gap to the
+/// mannequin all round is never larger by least squares; over the rings it is smaller.
+#[test]
+fn least_squares_places_the_skin_closer_than_one_offset_on_twenty_customers() {
+    let form = reference();
+    let fits: Vec<_> = (0..20)
+        .into_par_iter()
+        .map(|s| {
+            let profiles = profiles_of(&BodyParams::random(s));
+            let ls = fit_by(&profiles, &form, Placement::LeastSquares).unwrap();
+            let offset = fit_by(&profiles, &form, Placement::CommonOffset).unwrap();
+            assert_within_strokes(&ls);
+            (ls, offset)
+        })
+        .collect();
+    let mut sums = vec![(0.0, 0.0, 0usize); form.rings.len()];
+    for (ls, offset) in &fits {
+        for (k, (a, b)) in ls.rings.iter().zip(&offset.rings).enumerate() {
+            if !matches!(b.status(), RingStatus::Ok | RingStatus::ShapeLimited) {
+                continue;
+            }
+            assert!((a.form_girth_mm - a.mannequin_girth_mm).abs() < 0.1, "{}", a.ring);
+            assert!(
+                a.rms_radial_gap_mm <= b.rms_radial_gap_mm + 1e-6,
+                "{}: {:.2} by least squares, {:.2} by one offset",
+                a.ring,
+                a.rms_radial_gap_mm,
+                b.rms_radial_gap_mm
+            );
+            sums[k].0 += a.rms_radial_gap_mm.powi(2);
+            sums[k].1 += b.rms_radial_gap_mm.powi(2);
+            sums[k].2 += 1;
+        }
+    }
+    eprintln!("ring          rings  RMS gap (mm): one offset  least squares");
+    let (mut after, mut before) = (0.0, 0.0);
+    for (ring, (a, b, n)) in form.rings.iter().zip(&sums) {
+        let rms = |x: f64| (x / (*n).max(1) as f64).sqrt();
+        eprintln!("{:<12} {n:>6} {:>25.2} {:>14.2}", ring.name, rms(*b), rms(*a));
+        after += a;
+        before += b;
+    }
+    eprintln!("all rings: {:.2} -> {:.2} mm", before.sqrt(), after.sqrt());
+    assert!(after < before, "least squares no closer over all rings");
 }

@@ -45,23 +45,27 @@ pub fn fidelity_table(fit: &FormFit) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "  {:<12} {:>8} {:>8} {:>11} {:>9} {:>9}  status",
-        "ring", "form z", "body z", "mannequin", "form", "gap"
+        "  {:<12} {:>8} {:>8} {:>11} {:>9} {:>8} {:>8}  status",
+        "ring", "form z", "body z", "mannequin", "form", "rms gap", "max gap"
     );
     for r in &fit.rings {
         let _ = writeln!(
             s,
-            "  {:<12} {:>8.0} {:>8.0} {:>11.1} {:>9.1} {:>9.1}  {}",
+            "  {:<12} {:>8.0} {:>8.0} {:>11.1} {:>9.1} {:>8.1} {:>8.1}  {}",
             r.ring,
             r.form_height_mm,
             r.mannequin_height_mm,
             r.mannequin_girth_mm,
             r.form_girth_mm,
+            r.rms_radial_gap_mm,
             r.largest_radial_gap_mm,
             r.status(),
         );
     }
-    let _ = writeln!(s, "  (girths and the largest radial gap between panel and mannequin, mm)");
+    let _ = writeln!(
+        s,
+        "  (girths, and the radial gaps between the form's skin and the mannequin all round, mm)"
+    );
     for r in fit.saturated() {
         let actuators: Vec<String> = r.saturated.iter().map(|a| a.to_string()).collect();
         let _ = writeln!(s, "  {}: {} ({})", r.ring, r.girth_reach(), actuators.join(", "));

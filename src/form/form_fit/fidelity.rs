@@ -114,7 +114,9 @@ mod tests {
             offset_mm: 20.0,
             mannequin_girth_mm: mannequin,
             form_girth_mm: form,
+            rms_radial_gap_mm: 0.0,
             largest_radial_gap_mm: 0.0,
+            panel_gaps_mm: Default::default(),
             saturated: (saturated.iter())
                 .map(|&beyond_mm| Saturation { actuator: "waist-front".into(), beyond_mm })
                 .collect(),

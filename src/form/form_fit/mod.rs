@@ -1,6 +1,7 @@
 //! Fitting the robotic form to a mannequin: where each of the form's rings meets the mannequin
 //! ([`placement`]), and the actuator extensions that make each ring take the mannequin's
-//! section ([`rings`]), with a fidelity report ([`RingStatus`], [`GirthReach`]).
+//! section ([`rings`]: its girth exactly, its shape by least squares, [`least_squares`]), with a
+//! fidelity report ([`RingStatus`], [`GirthReach`], the radial gaps in [`RingFit`]).
 //!
 //! **Placement rule.** A ring whose description states an `anchor` (`neck`, `chest`, `waist`,
 //! `hip`) is set to the mannequin's neck landmark or its chest, waist or hip level; a ring
@@ -14,14 +15,16 @@
 //! canonical frame otherwise (+X = the subject's left, front = -Y).
 
 mod fidelity;
+mod least_squares;
 pub mod outcome;
 mod placement;
 mod rings;
 
 pub use fidelity::{GirthReach, RingStatus};
+pub use least_squares::GAP_RAYS;
 pub use outcome::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
 pub use placement::HeightMap;
-pub use rings::{RingFit, SHAPE_NOTE_MM, Saturation, region_of, ring_girth};
+pub use rings::{Placement, RingFit, SHAPE_NOTE_MM, Saturation, region_of, ring_girth};
 
 use crate::body::regions::Region;
 use crate::form::setpoints::SetPoints;
@@ -156,12 +159,21 @@ pub fn regions_of(form: &FormDescription) -> Vec<Region> {
 /// assert!((waist.form_girth_mm - waist.mannequin_girth_mm).abs() < 2.0);
 /// ```
 pub fn fit(profiles: &Profiles, form: &FormDescription) -> Result<FormFit, FormFitError> {
+    fit_by(profiles, form, Placement::default())
+}
+
+/// [`fit`] with the panels placed by `rule`.
+pub fn fit_by(
+    profiles: &Profiles,
+    form: &FormDescription,
+    rule: Placement,
+) -> Result<FormFit, FormFitError> {
     profiles.validate(&regions_of(form)).map_err(FormFitError::Invalid)?;
     let placement = HeightMap::new(profiles, form);
     let mut positions_mm = BTreeMap::new();
     let mut fits = Vec::with_capacity(form.rings.len());
     for ring in &form.rings {
-        let (fit, extensions) = rings::fit_ring(profiles, form, ring, &placement)?;
+        let (fit, extensions) = rings::fit_ring(profiles, form, ring, &placement, rule)?;
         positions_mm.extend(extensions);
         fits.push(fit);
     }

@@ -3,12 +3,16 @@
 //! The form's section at extensions `e` is modelled as the skin stretched over its panels: the
 //! convex hull of the panels (flat plates of their width, tangential, centred at
 //! `centre + (base_radius + e) · direction`). Each actuator's shape target is where its
-//! direction meets the mannequin's section (`R`, the farthest crossing); all targets then move
-//! by one radial offset `δ`, found by bisection, so that the skin's girth equals the
-//! mannequin's tape girth — girth first, shape second. Extensions are clamped to the stroke;
-//! an actuator whose target lies beyond it is reported with the excess.
+//! direction meets the mannequin's section (`R`, the farthest crossing). The start puts every
+//! panel's centre on its target and moves them all by one radial offset `δ`, found by
+//! bisection, so that the skin's girth equals the mannequin's tape girth (the common-offset
+//! rule, [`Placement::CommonOffset`]); the least-squares placement then moves the panels so
+//! that the skin lies as close to the section all round as the girth and the strokes allow
+//! ([`Placement::LeastSquares`], [`super::least_squares`]). Extensions stay within the
+//! stroke; an actuator whose target lies beyond it is reported with the excess.
 
 use super::HeightMap;
+use super::least_squares::{self, gap_directions, rms};
 use crate::body::regions::Region;
 use crate::body::slice::{Contour, convex_hull};
 use crate::shape::profiles::{ProfileLayer, Profiles};
@@ -22,6 +26,18 @@ use std::collections::BTreeMap;
 /// mannequin's own surface is known to (a denoised scan's sections to about a millimetre),
 /// and listing it would bury the real problems.
 pub const SHAPE_NOTE_MM: f64 = 1.0;
+
+/// How a ring's panels are placed once its girth is known.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Placement {
+    /// Least squares: the skin as close to the section all round as the girth and the
+    /// strokes allow (the `least_squares` module).
+    #[default]
+    LeastSquares,
+    /// Every panel's centre on the section, all moved by one offset to the girth: the rule
+    /// before issue 31, the least squares' start and the baseline its gain is measured on.
+    CommonOffset,
+}
 
 /// An actuator that cannot reach its target by at least [`SHAPE_NOTE_MM`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -50,9 +66,14 @@ pub struct RingFit {
     pub mannequin_girth_mm: f64,
     /// The form's girth at the set-points (mm).
     pub form_girth_mm: f64,
-    /// The largest distance, along an actuator's direction, between its panel and the
-    /// mannequin (mm).
+    /// The root mean square of the radial gaps between the form's skin and the mannequin's
+    /// section, over [`least_squares::GAP_RAYS`] rays from the ring's axis (mm).
+    pub rms_radial_gap_mm: f64,
+    /// The largest of those gaps, either way (mm).
     pub largest_radial_gap_mm: f64,
+    /// Per actuator, its panel's distance from the mannequin along its direction (mm):
+    /// positive where the panel stands outside the mannequin's surface, negative inside.
+    pub panel_gaps_mm: BTreeMap<String, f64>,
     /// Actuators that cannot reach their targets by [`SHAPE_NOTE_MM`] or more.
     pub saturated: Vec<Saturation>,
 }
@@ -100,7 +121,12 @@ pub fn ring_girth(
 
 /// Girth of the skin over the panels of `actuators` at `extensions`.
 fn skin_girth(centre: DVec2, actuators: &[&ActuatorSpec], extensions: &[f64]) -> f64 {
-    let ends: Vec<DVec2> = actuators
+    Contour { points: convex_hull(&skin_points(centre, actuators, extensions)) }.perimeter()
+}
+
+/// The ends of the panels of `actuators` at `extensions`: the skin is their convex hull.
+fn skin_points(centre: DVec2, actuators: &[&ActuatorSpec], extensions: &[f64]) -> Vec<DVec2> {
+    actuators
         .iter()
         .zip(extensions)
         .flat_map(|(a, e)| {
@@ -109,8 +135,7 @@ fn skin_girth(centre: DVec2, actuators: &[&ActuatorSpec], extensions: &[f64]) ->
             let half = d.perp() * (0.5 * a.panel_width_mm);
             [middle - half, middle + half]
         })
-        .collect();
-    Contour { points: convex_hull(&ends) }.perimeter()
+        .collect()
 }
 
 /// Halvings of the common offset's bracket: it starts a few hundred mm wide, and 60 halvings
@@ -131,6 +156,7 @@ pub(super) fn fit_ring(
     form: &FormDescription,
     ring: &RingSpec,
     placement: &HeightMap,
+    rule: Placement,
 ) -> Result<(RingFit, Vec<(String, f64)>), super::FormFitError> {
     let actuators: Vec<&ActuatorSpec> =
         form.actuators.iter().filter(|a| a.ring == ring.name).collect();
@@ -142,7 +168,8 @@ pub(super) fn fit_ring(
     let mut report = RingFit::placed(ring, z);
     let extensions = match section_at(profiles, region_of(ring), z) {
         Some(section) => {
-            Panels::against(&section, centre, &actuators).match_girth(&section, &mut report)
+            let groups = mirror_groups(form, &actuators);
+            Panels::against(&section, centre, &actuators).place(rule, &groups, &mut report)
         }
         // No mannequin there (above the neck, below the legs): the ring stays retracted.
         None => {
@@ -167,18 +194,47 @@ impl RingFit {
             offset_mm: ring.height_mm - z,
             mannequin_girth_mm: 0.0,
             form_girth_mm: 0.0,
+            rms_radial_gap_mm: 0.0,
             largest_radial_gap_mm: 0.0,
+            panel_gaps_mm: BTreeMap::new(),
             saturated: Vec::new(),
         }
     }
 }
 
-/// A ring's panels against the mannequin's section: where each actuator's direction meets it.
-struct Panels<'a> {
+/// For each of `actuators` (one ring's), the least-squares variable it shares with its mirror
+/// partner on the same ring (0-based, dense); actuators on the centre line and those whose
+/// partner is on another ring (a thigh's) have their own.
+fn mirror_groups(form: &FormDescription, actuators: &[&ActuatorSpec]) -> Vec<usize> {
+    let mut groups = vec![usize::MAX; actuators.len()];
+    let mut next = 0;
+    for k in 0..actuators.len() {
+        if groups[k] != usize::MAX {
+            continue;
+        }
+        groups[k] = next;
+        if let Some(partner) = form.mirror_of(&actuators[k].id)
+            && let Some(j) = actuators.iter().position(|a| a.id == partner.id)
+        {
+            groups[j] = next;
+        }
+        next += 1;
+    }
+    groups
+}
+
+/// A ring's panels against the mannequin's section: where each actuator's direction meets it,
+/// and the section's distance along the gap rays.
+pub(super) struct Panels<'a> {
     centre: DVec2,
     actuators: &'a [&'a ActuatorSpec],
     /// Distance from the ring's axis to the section along each actuator's direction.
     reach: Vec<f64>,
+    /// The gap rays' directions, and the section's distance along each.
+    rays: Vec<DVec2>,
+    section_radii: Vec<f64>,
+    /// The section's tape girth: the girth the skin must take.
+    target: f64,
 }
 
 impl<'a> Panels<'a> {
@@ -187,83 +243,292 @@ impl<'a> Panels<'a> {
     fn against(section: &Contour, centre: DVec2, actuators: &'a [&'a ActuatorSpec]) -> Self {
         let directions: Vec<DVec2> =
             actuators.iter().map(|a| DVec2::from_array(a.direction())).collect();
-        Panels { centre, reach: cast_along(section, centre, &directions), actuators }
+        let rays = gap_directions();
+        Panels {
+            centre,
+            reach: cast_along(section, centre, &directions),
+            section_radii: cast_along(section, centre, &rays),
+            rays,
+            actuators,
+            target: section.tape_girth(),
+        }
     }
 
-    /// The extensions whose skin takes the section's tape girth — girth first, shape second —
-    /// filling in `report`'s girths, largest gap and saturated actuators.
-    fn match_girth(&self, section: &Contour, report: &mut RingFit) -> Vec<f64> {
-        let target = section.tape_girth();
-        let delta = self.offset_for_girth(target);
-        let extensions = self.clamped(delta);
-        report.mannequin_girth_mm = target;
-        report.form_girth_mm = skin_girth(self.centre, self.actuators, &extensions);
-        report.largest_radial_gap_mm = self.largest_gap(&extensions);
-        // Where the girth is matched, the excess is measured at the solution; where the girth
-        // is out of reach, at the shape targets themselves (no common offset).
-        let matched = (report.form_girth_mm - target).abs() < GIRTH_MATCHED_MM;
-        report.saturated = self.saturations(if matched { delta } else { 0.0 });
+    /// The extensions whose skin takes the section's tape girth — girth first, shape second,
+    /// by `rule` — filling in `report`'s girths, gaps and saturated actuators.
+    fn place(&self, rule: Placement, groups: &[usize], report: &mut RingFit) -> Vec<f64> {
+        let start = self.on_section();
+        let delta = self.offset_for_girth(&start);
+        let mut extensions = self.clamped(&start, delta);
+        // Where the girth is out of reach, every panel is at an end of its stroke already.
+        let matched = (self.skin_girth(&extensions) - self.target).abs() < GIRTH_MATCHED_MM;
+        if matched && rule == Placement::LeastSquares {
+            extensions = least_squares::solve(self, &start, groups);
+        }
+        report.mannequin_girth_mm = self.target;
+        report.form_girth_mm = self.skin_girth(&extensions);
+        let gaps = self.gaps(&extensions);
+        report.rms_radial_gap_mm = rms(&gaps);
+        report.largest_radial_gap_mm = gaps.iter().fold(0.0, |m, g| m.max(g.abs()));
+        let ids = self.actuators.iter().map(|a| a.id.clone());
+        report.panel_gaps_mm = ids.zip(self.panel_gaps(&extensions)).collect();
+        // Where the girth is matched, the excess is measured at the common offset; where it
+        // is out of reach, at the shape targets themselves.
+        report.saturated = self.saturations(&start, if matched { delta } else { 0.0 });
         extensions
     }
 
-    /// The extensions that put every panel on the section, moved out by `delta` (unclamped).
-    fn raw(&self, delta: f64) -> Vec<f64> {
-        self.actuators.iter().zip(&self.reach).map(|(a, r)| r - a.base_radius_mm + delta).collect()
+    /// The extensions that put every panel's centre on the section.
+    fn on_section(&self) -> Vec<f64> {
+        self.actuators.iter().zip(&self.reach).map(|(a, r)| r - a.base_radius_mm).collect()
     }
 
-    /// [`raw`](Self::raw) within each actuator's stroke.
-    fn clamped(&self, delta: f64) -> Vec<f64> {
-        let raw = self.raw(delta);
-        raw.iter().zip(self.actuators).map(|(e, a)| e.clamp(0.0, a.stroke_mm)).collect()
+    /// `shape` moved out by `delta`, within each actuator's stroke.
+    fn clamped(&self, shape: &[f64], delta: f64) -> Vec<f64> {
+        shape.iter().zip(self.actuators).map(|(e, a)| (e + delta).clamp(0.0, a.stroke_mm)).collect()
     }
 
-    /// The common radial offset whose clamped extensions give the skin `target` girth
-    /// (bisection); the bracket's end when the girth is out of reach.
-    fn offset_for_girth(&self, target: f64) -> f64 {
-        let girth = |delta: f64| skin_girth(self.centre, self.actuators, &self.clamped(delta));
+    /// The skin's girth at `extensions`.
+    fn skin_girth(&self, extensions: &[f64]) -> f64 {
+        skin_girth(self.centre, self.actuators, extensions)
+    }
+
+    /// The common radial offset whose clamped extensions of `shape` give the skin the
+    /// section's girth (bisection); the bracket's end when the girth is out of reach.
+    fn offset_for_girth(&self, shape: &[f64]) -> f64 {
+        let girth = |delta: f64| self.skin_girth(&self.clamped(shape, delta));
         // Bracket: below `lo` every panel is retracted, above `hi` every panel is at full stroke.
-        let on_section =
-            || self.actuators.iter().zip(&self.reach).map(|(a, r)| r - a.base_radius_mm);
         let longest_stroke = self.actuators.iter().map(|a| a.stroke_mm).fold(0.0, f64::max);
         let (mut lo, mut hi) = (
-            -on_section().fold(f64::NEG_INFINITY, f64::max) - BRACKET_MARGIN_MM,
-            longest_stroke - on_section().fold(f64::INFINITY, f64::min) + BRACKET_MARGIN_MM,
+            -shape.iter().copied().fold(f64::NEG_INFINITY, f64::max) - BRACKET_MARGIN_MM,
+            longest_stroke - shape.iter().copied().fold(f64::INFINITY, f64::min)
+                + BRACKET_MARGIN_MM,
         );
-        if girth(hi) <= target {
+        if girth(hi) <= self.target {
             return hi;
         }
-        if girth(lo) >= target {
+        if girth(lo) >= self.target {
             return lo;
         }
         for _ in 0..BISECTION_STEPS {
             let mid = 0.5 * (lo + hi);
-            if girth(mid) < target { lo = mid } else { hi = mid }
+            if girth(mid) < self.target { lo = mid } else { hi = mid }
         }
         0.5 * (lo + hi)
     }
 
-    /// The largest distance between a panel at `extensions` and the section, along its
-    /// actuator's direction.
-    fn largest_gap(&self, extensions: &[f64]) -> f64 {
+    /// The actuators whose target (`shape` moved by `delta`) lies [`SHAPE_NOTE_MM`] or more
+    /// beyond their travel.
+    fn saturations(&self, shape: &[f64], delta: f64) -> Vec<Saturation> {
         self.actuators
             .iter()
-            .zip(&self.reach)
-            .zip(extensions)
-            .map(|((a, r), e)| (a.base_radius_mm + e - r).abs())
-            .fold(0.0, f64::max)
-    }
-
-    /// The actuators whose target at offset `delta` lies [`SHAPE_NOTE_MM`] or more beyond
-    /// their travel.
-    fn saturations(&self, delta: f64) -> Vec<Saturation> {
-        self.actuators
-            .iter()
-            .zip(self.raw(delta))
+            .zip(shape)
             .filter_map(|(a, e)| {
+                let e = e + delta;
                 let beyond = if e > a.stroke_mm { e - a.stroke_mm } else { e.min(0.0) };
                 (beyond.abs() >= SHAPE_NOTE_MM)
                     .then(|| Saturation { actuator: a.id.clone(), beyond_mm: beyond })
             })
             .collect()
+    }
+}
+
+impl Panels<'_> {
+    /// The skin's distance minus the section's along each gap ray, at `extensions`.
+    fn gaps(&self, extensions: &[f64]) -> Vec<f64> {
+        let ends = skin_points(self.centre, self.actuators, extensions);
+        let radii = cast_along(&Contour { points: convex_hull(&ends) }, self.centre, &self.rays);
+        radii.iter().zip(&self.section_radii).map(|(r, s)| r - s).collect()
+    }
+
+    /// How far each panel lies under the skin along its direction, at `extensions`: 0 for a
+    /// panel that carries the skin, more for one inside its neighbours' hull.
+    fn under_skin(&self, extensions: &[f64]) -> Vec<f64> {
+        let ends = skin_points(self.centre, self.actuators, extensions);
+        let skin = Contour { points: convex_hull(&ends) };
+        let directions: Vec<DVec2> =
+            self.actuators.iter().map(|a| DVec2::from_array(a.direction())).collect();
+        let radii = cast_along(&skin, self.centre, &directions);
+        let panels = self.actuators.iter().zip(radii).zip(extensions);
+        panels.map(|((a, r), e)| r - (a.base_radius_mm + e)).collect()
+    }
+
+    /// Each panel's distance from the section along its direction, at `extensions`: positive
+    /// outside the mannequin.
+    fn panel_gaps(&self, extensions: &[f64]) -> Vec<f64> {
+        let panels = self.actuators.iter().zip(&self.reach).zip(extensions);
+        panels.map(|((a, r), e)| a.base_radius_mm + e - r).collect()
+    }
+}
+
+impl least_squares::Ring for Panels<'_> {
+    fn extensions(&self, a: &[f64]) -> Vec<f64> {
+        self.clamped(a, self.offset_for_girth(a))
+    }
+
+    fn residuals(&self, extensions: &[f64]) -> Vec<f64> {
+        let mut residuals = self.gaps(extensions);
+        residuals.extend(self.under_skin(extensions));
+        residuals
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::least_squares::Ring;
+    use super::*;
+    use std::f64::consts::TAU;
+
+    /// A torso ring of eight actuators 45 degrees apart (front, back and three mirror pairs),
+    /// 100 mm from the axis retracted, panels 70 mm wide, 60 mm of stroke.
+    fn ring() -> Vec<ActuatorSpec> {
+        (0..8)
+            .map(|k| {
+                let angle = 45.0 * k as f64;
+                let partner = (8 - k) % 8;
+                ActuatorSpec {
+                    id: format!("a{k}"),
+                    node: 1,
+                    channel: k as u8,
+                    ring: "test".into(),
+                    angle_deg: angle,
+                    base_radius_mm: 100.0,
+                    panel_width_mm: 70.0,
+                    stroke_mm: 60.0,
+                    max_speed_mm_s: 10.0,
+                    max_accel_mm_s2: 50.0,
+                    mirror: (k > 0 && k < 4).then(|| format!("a{partner}")),
+                }
+            })
+            .collect()
+    }
+
+    /// The mirror groups of [`ring`]: a_k shares its variable with a_(8-k).
+    fn groups() -> Vec<usize> {
+        [0, 1, 2, 3, 4, 3, 2, 1].to_vec()
+    }
+
+    /// A section from its radius as a function of the angle from the front (-Y, counter-
+    /// clockwise seen from above, as the actuators' angles), sampled finely.
+    fn section(radius: impl Fn(f64) -> f64) -> Contour {
+        let points = (0..720)
+            .map(|i| {
+                let a = TAU * i as f64 / 720.0;
+                DVec2::new(a.sin(), -a.cos()) * radius(a)
+            })
+            .collect();
+        Contour { points }
+    }
+
+    /// Places [`ring`] on `section` by `rule`; returns the extensions and the report.
+    fn place(section: &Contour, rule: Placement) -> (Vec<f64>, RingFit) {
+        let specs = ring();
+        let actuators: Vec<&ActuatorSpec> = specs.iter().collect();
+        let panels = Panels::against(section, DVec2::ZERO, &actuators);
+        let spec = RingSpec {
+            name: "test".into(),
+            height_mm: 1000.0,
+            center_mm: [0.0, 0.0],
+            mirror: None,
+            part: BodyPart::Torso,
+            anchor: None,
+        };
+        let mut report = RingFit::placed(&spec, 1000.0);
+        let extensions = panels.place(rule, &groups(), &mut report);
+        (extensions, report)
+    }
+
+    /// The summed squared gap of extensions `e` on `section`.
+    fn cost(section: &Contour, e: &[f64]) -> f64 {
+        let specs = ring();
+        let actuators: Vec<&ActuatorSpec> = specs.iter().collect();
+        let panels = Panels::against(section, DVec2::ZERO, &actuators);
+        panels.residuals(e).iter().map(|g| g * g).sum()
+    }
+
+    /// Checks the least-squares placement on `section`: girth exact, mirror pairs equal,
+    /// within the strokes, no worse than the common offset, and no feasible move nearby
+    /// (shape vectors around the solution, girth restored) better. Returns the RMS gaps by
+    /// least squares and by the common offset.
+    fn check_optimum(section: &Contour) -> (f64, f64) {
+        let (e, fit) = place(section, Placement::LeastSquares);
+        let (_, before) = place(section, Placement::CommonOffset);
+        assert!((fit.form_girth_mm - fit.mannequin_girth_mm).abs() < GIRTH_MATCHED_MM);
+        for (k, g) in groups().iter().enumerate() {
+            let partner = groups().iter().rposition(|h| h == g).unwrap();
+            assert!((e[k] - e[partner]).abs() < 1e-9, "a{k} and its mirror");
+            assert!((0.0..=60.0).contains(&e[k]));
+        }
+        assert!(fit.rms_radial_gap_mm <= before.rms_radial_gap_mm + 1e-9);
+        let specs = ring();
+        let actuators: Vec<&ActuatorSpec> = specs.iter().collect();
+        let panels = Panels::against(section, DVec2::ZERO, &actuators);
+        let best = cost(section, &e);
+        for k in 0..8 {
+            for step in [-0.5, 0.5] {
+                let mut shape = e.clone();
+                // Move a mirror pair together, so the move stays symmetric.
+                for (j, g) in groups().iter().enumerate() {
+                    if *g == groups()[k] {
+                        shape[j] += step;
+                    }
+                }
+                let moved = panels.extensions(&shape);
+                assert!(cost(section, &moved) >= best - 1e-6, "a better placement moving a{k}");
+            }
+        }
+        (fit.rms_radial_gap_mm, before.rms_radial_gap_mm)
+    }
+
+    #[test]
+    fn a_circle_takes_equal_extensions_at_its_girth() {
+        let circle = section(|_| 140.0);
+        let (e, fit) = place(&circle, Placement::LeastSquares);
+        assert!(e.iter().all(|x| (x - e[0]).abs() < 1e-3), "{e:?}");
+        assert!((fit.form_girth_mm - TAU * 140.0).abs() < 0.1, "{}", fit.form_girth_mm);
+        check_optimum(&circle);
+    }
+
+    #[test]
+    fn a_section_shaped_as_the_panels_is_taken_exactly() {
+        // The skin of the ring at known extensions (mirror-symmetric, every panel on the
+        // skin) as the section: the optimum is those extensions, with no gap.
+        let specs = ring();
+        let actuators: Vec<&ActuatorSpec> = specs.iter().collect();
+        let known = [25.0, 22.0, 30.0, 24.0, 18.0, 24.0, 30.0, 22.0];
+        let skin = Contour { points: convex_hull(&skin_points(DVec2::ZERO, &actuators, &known)) };
+        let panels = Panels::against(&skin, DVec2::ZERO, &actuators);
+        assert!(panels.panel_gaps(&known).iter().all(|g| g.abs() < 1e-9), "all on the skin");
+        let (e, fit) = place(&skin, Placement::LeastSquares);
+        for k in 0..8 {
+            assert!((e[k] - known[k]).abs() < 0.01, "a{k}: {} vs {}", e[k], known[k]);
+        }
+        assert!(fit.rms_radial_gap_mm < 0.01, "{}", fit.rms_radial_gap_mm);
+    }
+
+    #[test]
+    fn an_ellipse_and_a_flat_backed_section_are_at_their_least_squares_optimum() {
+        let ellipse = section(|a| {
+            let (x, y) = (a.sin() / 160.0, a.cos() / 115.0);
+            1.0 / (x * x + y * y).sqrt()
+        });
+        // Round in front, flat across the back (y = 95 mm behind the axis).
+        let flat_back = section(|a| {
+            let behind = -a.cos();
+            if behind > 0.0 { 140.0_f64.min(95.0 / behind) } else { 140.0 }
+        });
+        for (name, s) in [("ellipse", ellipse), ("flat back", flat_back)] {
+            let (after, before) = check_optimum(&s);
+            eprintln!("{name}: RMS gap {after:.2} mm, by one offset {before:.2} mm");
+        }
+    }
+
+    #[test]
+    fn a_section_beyond_the_strokes_keeps_every_panel_at_its_end() {
+        let big = section(|_| 200.0);
+        let (e, fit) = place(&big, Placement::LeastSquares);
+        assert!(e.iter().all(|&x| x == 60.0), "{e:?}");
+        assert!(fit.mannequin_girth_mm - fit.form_girth_mm > 200.0);
+        assert_eq!(fit.saturated.len(), 8);
     }
 }
