@@ -14,6 +14,11 @@ use glam::DVec3;
 use rayon::prelude::*;
 use std::path::Path;
 
+/// The most the skin of a ring may stand off a customer's mannequin inside the form's range,
+/// RMS all round (mm): the reference form's shoulders ring measured 21-22 mm on the default
+/// and random customers, the other rings 2-16.
+const RMS_GAP_MM: f64 = 25.0;
+
 fn profiles_of(params: &BodyParams) -> Profiles {
     let body = generate(params).unwrap();
     let mesh = Mesh::new(
@@ -59,11 +64,18 @@ fn customers_inside_the_range_are_matched_within_2_mm_at_every_ring() {
                 ring.mannequin_girth_mm
             );
             // The girth is met; where the section's shape differs from the ring's panel layout
-            // (a flat back, a bust, a section wider than deep), the least squares leave panels
-            // off the mannequin (up to 31 mm inside at the hip's front, so that the sides and
-            // the back follow it at that girth), and the report gives every panel's gap.
+            // (a flat back, a bust, a section wider than deep), the skin stands off the
+            // mannequin, by least squares as little as the layout allows (the shoulders ring,
+            // whose section is wider than it reaches, 21-22 mm RMS; the rest 2-16), and the
+            // report gives every panel's own gap (some 20-30 mm inside, traded for the skin's
+            // fit all round).
+            assert!(
+                ring.rms_radial_gap_mm < RMS_GAP_MM,
+                "{}: the skin {:.1} mm RMS off the mannequin",
+                ring.ring,
+                ring.rms_radial_gap_mm
+            );
             let panels = form.actuators.iter().filter(|a| a.ring == ring.ring);
-            assert!(panels.clone().all(|a| ring.panel_gaps_mm.contains_key(&a.id)));
             assert_eq!(panels.count(), ring.panel_gaps_mm.len());
         }
         // Anchored rings sit on their levels: chest, waist, hip at offset 0 from their level.

@@ -6,9 +6,13 @@ use super::adjacency::Incidence;
 /// The triangles reached from `seeds` (one flag per triangle) by stepping to triangles that
 /// share a vertex and that `admit` accepts (by index): the seeds and everything so reached.
 pub fn grow(mesh: &Mesh, seeds: &[bool], admit: impl Fn(usize) -> bool) -> Vec<bool> {
-    let around = Incidence::triangles(mesh);
+    debug_assert_eq!(seeds.len(), mesh.triangles.len(), "a flag per triangle");
     let mut reached = seeds.to_vec();
     let mut front: Vec<usize> = (0..seeds.len()).filter(|&t| seeds[t]).collect();
+    if front.is_empty() {
+        return reached;
+    }
+    let around = Incidence::triangles(mesh);
     while let Some(t) = front.pop() {
         for &v in &mesh.triangles[t] {
             for &n in around.of(v as usize) {

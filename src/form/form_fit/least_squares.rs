@@ -11,14 +11,16 @@
 //! neighbours' hull changes no ray's gap, and would otherwise drift with the girth's offset
 //! instead of carrying the skin.
 //! The girth constraint is eliminated: a shape vector `a` gives `e = clamp(a + δ(a))`, `δ(a)`
-//! the common offset that makes the girth exact ([`super::rings::Panels::offset_for_girth`],
-//! by bisection), so every extension the solver tries is feasible, and every feasible `e` is
-//! some `a`'s. `a` is improved by Levenberg-Marquardt (damped Gauss-Newton) with a Jacobian
-//! by central differences; a clamped actuator still has a one-sided slope there, so one that
-//! does better inside its stroke comes back. Mirror partners on the ring share one variable,
-//! so a symmetric section gets a symmetric placement. The start is the common-offset rule
-//! (each panel's centre on the section, all moved out by one offset): the result's summed
-//! squared gap is never larger than the start's.
+//! the common offset that makes the girth exact (`Panels::offset_for_girth` in
+//! [`super::rings`], by bisection), so every extension the solver tries is feasible, and every
+//! feasible `e` is some `a`'s. `a` is improved by Levenberg-Marquardt (damped Gauss-Newton)
+//! with a Jacobian by central differences; after each step `a` is set to the extensions it
+//! gave, so a clamped actuator sits exactly at its bound, where it still has a one-sided slope
+//! (one that does better inside its stroke comes back), and the offset's free direction (any
+//! constant added to `a`) never accumulates. Mirror partners on the ring share one variable,
+//! so a symmetric section gets a symmetric placement. The start is the common-offset rule's
+//! extensions (each panel's centre on the section, all moved out by one offset); the caller
+//! keeps them where the solution's skin is not closer.
 //!
 //! Written by hand: the problem is a handful of variables with a non-smooth constraint that a
 //! bisection already solves, and a general optimiser crate would not know to keep the girth.
@@ -31,16 +33,20 @@ use nalgebra::{DMatrix, DVector};
 /// a whole degree, so panels at whole-degree angles see their neighbours' rays alike.
 pub const GAP_RAYS: usize = 360;
 
-/// Step of the central differences (mm): far above the bisection's resolution (1e-12 mm) and
-/// far below a panel's width.
+/// Step of the central differences (mm): far above the bisection's resolution (about
+/// 1e-15 mm) and far below a panel's width.
 const DIFFERENCE_MM: f64 = 0.05;
-/// Iterations at most: the problem is nearly linear in the extensions, and converges in 5-15.
+/// Iterations at most: each costs one residual per variable pair and a few trial steps; on
+/// the reference form's rings the extensions settle within a few dozen.
 const MAX_ITERATIONS: usize = 40;
-/// Stop when no variable moves more than this in a step (mm).
+/// Stop when no extension moves more than this in a step (mm): a hundredth of the
+/// actuators' resolution (0.01 mm, the wire contract's position unit).
 const STEP_TOLERANCE_MM: f64 = 1e-4;
-/// Levenberg-Marquardt damping: its start, its factor up and down, and the largest tried
-/// before a step is given up.
-const DAMPING_START: f64 = 1e-3;
+/// Levenberg-Marquardt damping (relative to the normal matrix's diagonal): the smallest
+/// used, where the problem is nearly linear (Gauss-Newton's step); the factor it moves by
+/// after a rejected or accepted step; and the largest tried before the solve stops (a step
+/// then shorter than [`STEP_TOLERANCE_MM`]). The usual choices (Nocedal and Wright, ch. 10).
+const DAMPING_MIN: f64 = 1e-3;
 const DAMPING_FACTOR: f64 = 10.0;
 const DAMPING_MAX: f64 = 1e8;
 
@@ -54,26 +60,32 @@ pub(super) trait Ring {
     fn residuals(&self, extensions: &[f64]) -> Vec<f64>;
 }
 
-/// The least-squares extensions of `ring` from `start` (a shape vector); `groups[k]` is the
-/// variable actuator `k` shares with its mirror partner (0-based, dense).
+/// The least-squares extensions of `ring` from `start` (feasible extensions, mirror partners
+/// equal); `groups[k]` is the variable actuator `k` shares with its mirror partner (0-based,
+/// dense).
 pub(super) fn solve(ring: &impl Ring, start: &[f64], groups: &[usize]) -> Vec<f64> {
     let n = groups.iter().max().map_or(0, |g| g + 1);
     let spread = |v: &DVector<f64>| -> Vec<f64> { groups.iter().map(|&g| v[g]).collect() };
-    // The start's variables: the mean of each group's.
-    let mut x = DVector::zeros(n);
-    let mut counts = vec![0.0; n];
-    for (k, &g) in groups.iter().enumerate() {
-        x[g] += start[k];
-        counts[g] += 1.0;
-    }
-    for g in 0..n {
-        x[g] /= counts[g];
-    }
-    let residual =
-        |x: &DVector<f64>| DVector::from_vec(ring.residuals(&ring.extensions(&spread(x))));
-    let mut r = residual(&x);
+    // Each group's variable: the mean of its actuators' extensions.
+    let gather = |e: &[f64]| -> DVector<f64> {
+        let mut x = DVector::zeros(n);
+        let mut counts = vec![0.0; n];
+        for (k, &g) in groups.iter().enumerate() {
+            x[g] += e[k];
+            counts[g] += 1.0;
+        }
+        debug_assert!(counts.iter().all(|&c| c > 0.0), "groups are dense");
+        x.component_div_assign(&DVector::from_vec(counts));
+        x
+    };
+    let residual = |x: &DVector<f64>| {
+        let e = ring.extensions(&spread(x));
+        (DVector::from_vec(ring.residuals(&e)), e)
+    };
+    let mut x = gather(start);
+    let (mut r, mut e) = residual(&x);
     let mut cost = r.norm_squared();
-    let mut damping = DAMPING_START;
+    let mut damping = DAMPING_MIN;
     for _ in 0..MAX_ITERATIONS {
         let mut jacobian = DMatrix::zeros(r.len(), n);
         for g in 0..n {
@@ -81,12 +93,12 @@ pub(super) fn solve(ring: &impl Ring, start: &[f64], groups: &[usize]) -> Vec<f6
             up[g] += DIFFERENCE_MM;
             let mut down = x.clone();
             down[g] -= DIFFERENCE_MM;
-            let column = (residual(&up) - residual(&down)) / (2.0 * DIFFERENCE_MM);
+            let column = (residual(&up).0 - residual(&down).0) / (2.0 * DIFFERENCE_MM);
             jacobian.set_column(g, &column);
         }
         let normal = jacobian.transpose() * &jacobian;
         let gradient = jacobian.transpose() * &r;
-        let mut stepped = false;
+        let mut moved = 0.0;
         while damping <= DAMPING_MAX {
             let mut damped = normal.clone();
             for g in 0..n {
@@ -96,23 +108,21 @@ pub(super) fn solve(ring: &impl Ring, start: &[f64], groups: &[usize]) -> Vec<f6
                 damping *= DAMPING_FACTOR;
                 continue;
             };
-            let next = &x + &step;
-            let next_r = residual(&next);
+            let (next_r, next_e) = residual(&(&x + &step));
             let next_cost = next_r.norm_squared();
             if next_cost < cost {
-                let moved = step.amax();
-                (x, r, cost) = (next, next_r, next_cost);
-                damping = (damping / DAMPING_FACTOR).max(f64::MIN_POSITIVE);
-                stepped = moved > STEP_TOLERANCE_MM;
+                moved = next_e.iter().zip(&e).fold(0.0, |m: f64, (a, b)| m.max((a - b).abs()));
+                (x, r, e, cost) = (gather(&next_e), next_r, next_e, next_cost);
+                damping = (damping / DAMPING_FACTOR).max(DAMPING_MIN);
                 break;
             }
             damping *= DAMPING_FACTOR;
         }
-        if !stepped {
+        if moved <= STEP_TOLERANCE_MM {
             break;
         }
     }
-    ring.extensions(&spread(&x))
+    e
 }
 
 /// The root mean square of `gaps` (mm).

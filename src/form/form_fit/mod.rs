@@ -177,7 +177,8 @@ pub fn fit_by(
         positions_mm.extend(extensions);
         fits.push(fit);
     }
-    // Mirror pairs: the mean of the two (they differ only by rounding on a symmetric mannequin).
+    // Mirror pairs: the mean of the two (on a symmetric mannequin they differ only by rounding
+    // and, across two rings such as the thighs, by the least squares' tolerance, 1e-4 mm).
     for a in &form.actuators {
         if let Some(b) = form.mirror_of(&a.id).filter(|b| b.id != a.id) {
             let mean = 0.5 * (positions_mm[&a.id] + positions_mm[&b.id]);

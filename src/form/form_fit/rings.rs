@@ -69,12 +69,15 @@ pub struct RingFit {
     /// The root mean square of the radial gaps between the form's skin and the mannequin's
     /// section, over [`least_squares::GAP_RAYS`] rays from the ring's axis (mm).
     pub rms_radial_gap_mm: f64,
-    /// The largest of those gaps, either way (mm).
+    /// The largest of those gaps, either way (mm). (Before issue 31 this was the largest
+    /// gap at the panels' centres: that is now the largest of [`Self::panel_gaps_mm`].)
     pub largest_radial_gap_mm: f64,
     /// Per actuator, its panel's distance from the mannequin along its direction (mm):
     /// positive where the panel stands outside the mannequin's surface, negative inside.
     pub panel_gaps_mm: BTreeMap<String, f64>,
-    /// Actuators that cannot reach their targets by [`SHAPE_NOTE_MM`] or more.
+    /// Actuators resting at an end of their stroke whose targets (their direction's crossing
+    /// of the section, moved by the girth's common offset) lie [`SHAPE_NOTE_MM`] or more
+    /// beyond it.
     pub saturated: Vec<Saturation>,
 }
 
@@ -150,7 +153,7 @@ const GIRTH_MATCHED_MM: f64 = 0.01;
 
 /// Fits one ring; returns its report and the extensions of its actuators. Steps: place the
 /// ring on the mannequin ([`HeightMap`]), take the mannequin's section there, then match its
-/// girth ([`Panels::match_girth`]); a ring with no section stays retracted.
+/// girth and shape ([`Panels::place`]); a ring with no section stays retracted.
 pub(super) fn fit_ring(
     profiles: &Profiles,
     form: &FormDescription,
@@ -168,7 +171,7 @@ pub(super) fn fit_ring(
     let mut report = RingFit::placed(ring, z);
     let extensions = match section_at(profiles, region_of(ring), z) {
         Some(section) => {
-            let groups = mirror_groups(form, &actuators);
+            let groups = mirror_groups(&actuators);
             Panels::against(&section, centre, &actuators).place(rule, &groups, &mut report)
         }
         // No mannequin there (above the neck, below the legs): the ring stays retracted.
@@ -203,9 +206,10 @@ impl RingFit {
 }
 
 /// For each of `actuators` (one ring's), the least-squares variable it shares with its mirror
-/// partner on the same ring (0-based, dense); actuators on the centre line and those whose
-/// partner is on another ring (a thigh's) have their own.
-fn mirror_groups(form: &FormDescription, actuators: &[&ActuatorSpec]) -> Vec<usize> {
+/// partner on the same ring (0-based, dense): the partner it names or that names it.
+/// Actuators on the centre line and those whose partner is on another ring (a thigh's) have
+/// their own.
+fn mirror_groups(actuators: &[&ActuatorSpec]) -> Vec<usize> {
     let mut groups = vec![usize::MAX; actuators.len()];
     let mut next = 0;
     for k in 0..actuators.len() {
@@ -213,9 +217,13 @@ fn mirror_groups(form: &FormDescription, actuators: &[&ActuatorSpec]) -> Vec<usi
             continue;
         }
         groups[k] = next;
-        if let Some(partner) = form.mirror_of(&actuators[k].id)
-            && let Some(j) = actuators.iter().position(|a| a.id == partner.id)
-        {
+        let a = actuators[k];
+        let partner = actuators.iter().position(|b| {
+            b.id != a.id
+                && (a.mirror.as_deref() == Some(b.id.as_str())
+                    || b.mirror.as_deref() == Some(a.id.as_str()))
+        });
+        if let Some(j) = partner {
             groups[j] = next;
         }
         next += 1;
@@ -257,13 +265,20 @@ impl<'a> Panels<'a> {
     /// The extensions whose skin takes the section's tape girth — girth first, shape second,
     /// by `rule` — filling in `report`'s girths, gaps and saturated actuators.
     fn place(&self, rule: Placement, groups: &[usize], report: &mut RingFit) -> Vec<f64> {
-        let start = self.on_section();
-        let delta = self.offset_for_girth(&start);
-        let mut extensions = self.clamped(&start, delta);
+        let targets = self.on_section();
+        let delta = self.offset_for_girth(&targets);
+        let common = self.clamped(&targets, delta);
         // Where the girth is out of reach, every panel is at an end of its stroke already.
-        let matched = (self.skin_girth(&extensions) - self.target).abs() < GIRTH_MATCHED_MM;
+        let matched = (self.skin_girth(&common) - self.target).abs() < GIRTH_MATCHED_MM;
+        let mut extensions = common.clone();
         if matched && rule == Placement::LeastSquares {
-            extensions = least_squares::solve(self, &start, groups);
+            // Started from the common offset's (clamped, girth matched) extensions; kept only
+            // where the skin's RMS gap is no larger (the solver's sum also holds the panels'
+            // depths under the skin).
+            let solved = least_squares::solve(self, &common, groups);
+            if rms(&self.gaps(&solved)) <= rms(&self.gaps(&common)) {
+                extensions = solved;
+            }
         }
         report.mannequin_girth_mm = self.target;
         report.form_girth_mm = self.skin_girth(&extensions);
@@ -272,9 +287,15 @@ impl<'a> Panels<'a> {
         report.largest_radial_gap_mm = gaps.iter().fold(0.0, |m, g| m.max(g.abs()));
         let ids = self.actuators.iter().map(|a| a.id.clone());
         report.panel_gaps_mm = ids.zip(self.panel_gaps(&extensions)).collect();
-        // Where the girth is matched, the excess is measured at the common offset; where it
-        // is out of reach, at the shape targets themselves.
-        report.saturated = self.saturations(&start, if matched { delta } else { 0.0 });
+        // Where the girth is matched, a target's excess is measured at the common offset (and
+        // listed only while its panel rests at that end of its stroke); where it is out of
+        // reach, at the shape targets themselves.
+        report.saturated = self.saturations(&targets, if matched { delta } else { 0.0 });
+        report.saturated.retain(|s| {
+            let k = self.actuators.iter().position(|a| a.id == s.actuator).unwrap_or(0);
+            let end = if s.beyond_mm > 0.0 { self.actuators[k].stroke_mm } else { 0.0 };
+            extensions[k] == end
+        });
         extensions
     }
 
@@ -434,7 +455,7 @@ mod tests {
             anchor: None,
         };
         let mut report = RingFit::placed(&spec, 1000.0);
-        let extensions = panels.place(rule, &groups(), &mut report);
+        let extensions = panels.place(rule, &mirror_groups(&actuators), &mut report);
         (extensions, report)
     }
 
@@ -490,20 +511,55 @@ mod tests {
     }
 
     #[test]
-    fn a_section_shaped_as_the_panels_is_taken_exactly() {
+    fn mirror_partners_share_a_variable() {
+        let specs = ring();
+        let actuators: Vec<&ActuatorSpec> = specs.iter().collect();
+        assert_eq!(mirror_groups(&actuators), groups());
+    }
+
+    /// The skin of [`ring`] at `known` extensions as a section.
+    fn skin_of(specs: &[ActuatorSpec], known: &[f64]) -> Contour {
+        let actuators: Vec<&ActuatorSpec> = specs.iter().collect();
+        Contour { points: convex_hull(&skin_points(DVec2::ZERO, &actuators, known)) }
+    }
+
+    #[test]
+    fn a_section_shaped_as_the_panels_is_found_from_elsewhere() {
         // The skin of the ring at known extensions (mirror-symmetric, every panel on the
-        // skin) as the section: the optimum is those extensions, with no gap.
+        // skin) as the section: the optimum is those extensions, with no gap; the solver
+        // finds them from a start 4-6 mm off (the common offset's would start on them).
         let specs = ring();
         let actuators: Vec<&ActuatorSpec> = specs.iter().collect();
         let known = [25.0, 22.0, 30.0, 24.0, 18.0, 24.0, 30.0, 22.0];
-        let skin = Contour { points: convex_hull(&skin_points(DVec2::ZERO, &actuators, &known)) };
+        let skin = skin_of(&specs, &known);
         let panels = Panels::against(&skin, DVec2::ZERO, &actuators);
         assert!(panels.panel_gaps(&known).iter().all(|g| g.abs() < 1e-9), "all on the skin");
-        let (e, fit) = place(&skin, Placement::LeastSquares);
+        let off = [29.0, 17.0, 34.0, 19.0, 23.0, 19.0, 34.0, 17.0];
+        let e = least_squares::solve(&panels, &panels.extensions(&off), &groups());
         for k in 0..8 {
             assert!((e[k] - known[k]).abs() < 0.01, "a{k}: {} vs {}", e[k], known[k]);
         }
-        assert!(fit.rms_radial_gap_mm < 0.01, "{}", fit.rms_radial_gap_mm);
+        assert!(rms(&panels.gaps(&e)) < 0.01);
+    }
+
+    #[test]
+    fn an_optimum_at_a_stroke_end_is_kept_there() {
+        // As above, with the side panels' (a2, a6) stroke ending at their known 30 mm, and a
+        // start that puts them at that end: they stay there, and the rest find their places.
+        let mut specs = ring();
+        for k in [2, 6] {
+            specs[k].stroke_mm = 30.0;
+        }
+        let actuators: Vec<&ActuatorSpec> = specs.iter().collect();
+        let known = [25.0, 22.0, 30.0, 24.0, 18.0, 24.0, 30.0, 22.0];
+        let panels = Panels::against(&skin_of(&specs, &known), DVec2::ZERO, &actuators);
+        let start = panels.extensions(&[21.0, 26.0, 36.0, 20.0, 14.0, 20.0, 36.0, 26.0]);
+        assert_eq!([start[2], start[6]], [30.0, 30.0], "the start is at the stroke's end");
+        let e = least_squares::solve(&panels, &start, &groups());
+        for k in 0..8 {
+            assert!((e[k] - known[k]).abs() < 0.01, "a{k}: {} vs {}", e[k], known[k]);
+            assert!(e[k] <= specs[k].stroke_mm);
+        }
     }
 
     #[test]
