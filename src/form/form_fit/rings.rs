@@ -236,7 +236,9 @@ fn mirror_groups(actuators: &[&ActuatorSpec]) -> Vec<usize> {
 pub(super) struct Panels<'a> {
     centre: DVec2,
     actuators: &'a [&'a ActuatorSpec],
-    /// Distance from the ring's axis to the section along each actuator's direction.
+    /// Each actuator's direction, and the distance from the ring's axis to the section
+    /// along it.
+    directions: Vec<DVec2>,
     reach: Vec<f64>,
     /// The gap rays' directions, and the section's distance along each.
     rays: Vec<DVec2>,
@@ -255,6 +257,7 @@ impl<'a> Panels<'a> {
         Panels {
             centre,
             reach: cast_along(section, centre, &directions),
+            directions,
             section_radii: cast_along(section, centre, &rays),
             rays,
             actuators,
@@ -290,12 +293,8 @@ impl<'a> Panels<'a> {
         // Where the girth is matched, a target's excess is measured at the common offset (and
         // listed only while its panel rests at that end of its stroke); where it is out of
         // reach, at the shape targets themselves.
-        report.saturated = self.saturations(&targets, if matched { delta } else { 0.0 });
-        report.saturated.retain(|s| {
-            let k = self.actuators.iter().position(|a| a.id == s.actuator).unwrap_or(0);
-            let end = if s.beyond_mm > 0.0 { self.actuators[k].stroke_mm } else { 0.0 };
-            extensions[k] == end
-        });
+        report.saturated =
+            self.saturations(&targets, if matched { delta } else { 0.0 }, &extensions);
         extensions
     }
 
@@ -338,38 +337,46 @@ impl<'a> Panels<'a> {
         0.5 * (lo + hi)
     }
 
-    /// The actuators whose target (`shape` moved by `delta`) lies [`SHAPE_NOTE_MM`] or more
-    /// beyond their travel.
-    fn saturations(&self, shape: &[f64], delta: f64) -> Vec<Saturation> {
+    /// The actuators resting at an end of their stroke (at `extensions`) whose target
+    /// (`shape` moved by `delta`) lies [`SHAPE_NOTE_MM`] or more beyond that end.
+    fn saturations(&self, shape: &[f64], delta: f64, extensions: &[f64]) -> Vec<Saturation> {
         self.actuators
             .iter()
             .zip(shape)
-            .filter_map(|(a, e)| {
+            .zip(extensions)
+            .filter_map(|((a, e), &at)| {
                 let e = e + delta;
-                let beyond = if e > a.stroke_mm { e - a.stroke_mm } else { e.min(0.0) };
-                (beyond.abs() >= SHAPE_NOTE_MM)
+                let (beyond, end) = if e > a.stroke_mm {
+                    (e - a.stroke_mm, a.stroke_mm)
+                } else {
+                    (e.min(0.0), 0.0)
+                };
+                (beyond.abs() >= SHAPE_NOTE_MM && at == end)
                     .then(|| Saturation { actuator: a.id.clone(), beyond_mm: beyond })
             })
             .collect()
     }
-}
 
-impl Panels<'_> {
-    /// The skin's distance minus the section's along each gap ray, at `extensions`.
-    fn gaps(&self, extensions: &[f64]) -> Vec<f64> {
-        let ends = skin_points(self.centre, self.actuators, extensions);
-        let radii = cast_along(&Contour { points: convex_hull(&ends) }, self.centre, &self.rays);
+    /// The skin over the panels at `extensions`: their ends' convex hull.
+    fn skin(&self, extensions: &[f64]) -> Contour {
+        Contour { points: convex_hull(&skin_points(self.centre, self.actuators, extensions)) }
+    }
+
+    /// The skin's distance minus the section's along each gap ray, on `skin`.
+    fn gaps_of(&self, skin: &Contour) -> Vec<f64> {
+        let radii = cast_along(skin, self.centre, &self.rays);
         radii.iter().zip(&self.section_radii).map(|(r, s)| r - s).collect()
     }
 
-    /// How far each panel lies under the skin along its direction, at `extensions`: 0 for a
+    /// The skin's distance minus the section's along each gap ray, at `extensions`.
+    fn gaps(&self, extensions: &[f64]) -> Vec<f64> {
+        self.gaps_of(&self.skin(extensions))
+    }
+
+    /// How far each panel at `extensions` lies under `skin` along its direction: 0 for a
     /// panel that carries the skin, more for one inside its neighbours' hull.
-    fn under_skin(&self, extensions: &[f64]) -> Vec<f64> {
-        let ends = skin_points(self.centre, self.actuators, extensions);
-        let skin = Contour { points: convex_hull(&ends) };
-        let directions: Vec<DVec2> =
-            self.actuators.iter().map(|a| DVec2::from_array(a.direction())).collect();
-        let radii = cast_along(&skin, self.centre, &directions);
+    fn under_skin(&self, skin: &Contour, extensions: &[f64]) -> Vec<f64> {
+        let radii = cast_along(skin, self.centre, &self.directions);
         let panels = self.actuators.iter().zip(radii).zip(extensions);
         panels.map(|((a, r), e)| r - (a.base_radius_mm + e)).collect()
     }
@@ -388,8 +395,9 @@ impl least_squares::Ring for Panels<'_> {
     }
 
     fn residuals(&self, extensions: &[f64]) -> Vec<f64> {
-        let mut residuals = self.gaps(extensions);
-        residuals.extend(self.under_skin(extensions));
+        let skin = self.skin(extensions);
+        let mut residuals = self.gaps_of(&skin);
+        residuals.extend(self.under_skin(&skin, extensions));
         residuals
     }
 }
