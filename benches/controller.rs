@@ -1,5 +1,5 @@
-//! A full-form update of the reference form (all 64 actuators on 8 nodes) through the host
-//! controller on the in-process simulated bus at 1 Mbit/s (classic CAN and CAN FD 1/5):
+//! A full-form update of the reference form (all 72 actuators, lifts included, on 9 nodes)
+//! through the host controller on the in-process simulated bus at 1 Mbit/s (classic CAN and CAN FD 1/5):
 //! checking the set-points into safe targets, building the fewest frames, sending them all
 //! until the SYNC has crossed the bus.
 //!
@@ -23,10 +23,9 @@ use form_sim::bus::can::{CanBus, CanKind};
 
 fn setpoints(form: &FormDescription) -> SetPoints {
     let positions: BTreeMap<String, f64> = form
-        .actuators
-        .iter()
+        .axes()
         .enumerate()
-        .map(|(i, a)| (a.id.clone(), a.stroke_mm * (0.1 + 0.01 * i as f64)))
+        .map(|(i, a)| (a.id.to_string(), a.stroke_mm * (0.1 + 0.01 * i as f64)))
         .collect();
     SetPoints::new(form.name.clone(), positions)
 }

@@ -36,6 +36,33 @@ fn drive_on_the_simulated_form_reports_every_actuator() {
     }
 }
 
+/// A lift is driven like any actuator, and a ring its lifts leave off its level by more than
+/// `--height-tolerance` (default 5 mm) makes the drive exit 3 naming it; the male form is a
+/// built-in `--form`.
+#[test]
+fn a_ring_off_its_level_exits_3_and_the_tolerance_is_a_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    // The column raised 40 mm: the waist (built at 870 mm) stands at 910; its level is 922.
+    let path = dir.path().join("setpoints.json");
+    let text = r#"{"format": "dressform-setpoints/1", "form": "reference",
+        "positions_mm": {"height": 40}, "target_heights_mm": {"waist": 922}}"#;
+    std::fs::write(&path, text).unwrap();
+    let file = path.display().to_string();
+    let out = dressform(&["drive", &file, "--sim"]);
+    let (stdout, stderr) =
+        (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(3), "{stdout}\n{stderr}");
+    assert!(stderr.contains("waist 12 mm below its level (at 910 mm, 922 wanted)"), "{stderr}");
+    assert!(stdout.contains("height") && stdout.contains("910.0"), "{stdout}");
+    let out = dressform(&["drive", &file, "--sim", "--height-tolerance", "15"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text =
+        r#"{"format": "dressform-setpoints/1", "form": "male", "positions_mm": {"height": 10}}"#;
+    std::fs::write(&path, text).unwrap();
+    let out = dressform(&["drive", &file, "--sim", "--form", "male"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
 #[test]
 fn an_out_of_stroke_file_is_refused_with_its_offenders_or_clamped() {
     let dir = tempfile::tempdir().unwrap();
@@ -64,7 +91,7 @@ fn status_lists_every_node_and_estop_needs_a_link() {
     let out = dressform(&["status", "--sim"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}");
-    for node in 1..=8 {
+    for node in 1..=9 {
         assert!(
             stdout.contains(&format!("node {node}: Disabled (protocol 1.0, firmware 1.0.0)")),
             "{stdout}"
@@ -99,7 +126,10 @@ fn the_builtin_form_serves_every_command() {
     assert_eq!(form, form_description::reference());
     let out = dressform(&["form", "show"]);
     let summary = String::from_utf8_lossy(&out.stdout);
-    assert!(summary.contains("form \"reference\": 8 nodes, 9 rings, 64 actuators"), "{summary}");
+    assert!(
+        summary.contains("form \"reference\": 9 nodes, 9 rings, 64 actuators, 8 lifts"),
+        "{summary}"
+    );
     assert!(summary.contains("waist") && summary.contains("695 .. 1038"), "{summary}");
 
     // estop --sim and status --sim: a simulated form that lives for the command.
@@ -107,7 +137,7 @@ fn the_builtin_form_serves_every_command() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}");
     assert!(stdout.contains("started for this command"), "{stdout}");
-    assert_eq!(stdout.matches("EMERGENCY_STOP").count(), 8, "{stdout}");
+    assert_eq!(stdout.matches("EMERGENCY_STOP").count(), 9, "{stdout}");
     let out = dressform(&["status", "--sim"]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("started for this command"));
     let out = dressform(&["reset", "--sim"]);

@@ -60,7 +60,9 @@ struct Rig {
 /// (one feedback period: the first packet after the stall is node 5's).
 fn every_node_silent(from: Duration, stall: Duration) -> String {
     let others = stall + Duration::from_millis(20);
-    (1..=8)
+    let nodes = reference().nodes.iter().map(|n| n.address).collect::<Vec<_>>();
+    nodes
+        .into_iter()
         .map(|n| {
             let to = from + if n == 5 { stall } else { others };
             format!("node{n}:silent@{}ms..{}ms", from.as_millis(), to.as_millis())
@@ -131,7 +133,10 @@ async fn a_stall_past_the_limit_that_ended_during_a_request_is_still_the_links()
 async fn a_silent_node_is_lost_on_its_own_silence_the_links_stall_left_out() {
     let faults = format!(
         "node2:silent@1s,{}",
-        (1..=8)
+        reference()
+            .nodes
+            .iter()
+            .map(|n| n.address)
             .filter(|&n| n != 2)
             .map(|n| format!("node{n}:silent@1200ms..1700ms"))
             .collect::<Vec<_>>()

@@ -66,7 +66,7 @@ fn drives_the_form_over_a_serial_pty() {
     let connection = Connection::open(&LinkSpec::Serial(server.device_path().into())).unwrap();
     let form = reference();
     let nodes = runtime.block_on(status(connection, &form, Duration::from_millis(200))).unwrap();
-    assert_eq!(nodes.len(), 8);
+    assert_eq!(nodes.len(), form.nodes.len());
     for node in &nodes {
         assert!(node.identified && node.problems.is_empty(), "{node:?}");
         assert_eq!(node.state.as_deref(), Some("Disabled"), "{node:?}");
@@ -131,7 +131,7 @@ fn a_host_that_went_away_leaves_no_answers_for_the_next() {
 }
 
 /// Behind a slow adapter (every frame 20 ms late each way, as behind a USB-serial adapter's
-/// latency timer) one poll of the 8 nodes takes over 300 ms (the CAN loss limit); nodes that
+/// latency timer) one poll of the 9 nodes takes over 300 ms (the CAN loss limit); nodes that
 /// answer every poll are not lost for it, and the move completes.
 #[test]
 fn a_slow_serial_adapter_does_not_make_answering_nodes_lost() {

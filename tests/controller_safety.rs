@@ -104,8 +104,8 @@ proptest! {
 
     #[test]
     fn the_host_never_sends_a_target_outside_the_stroke(
-        picks in proptest::collection::btree_map(0usize..64, position(), 0..20),
-        strokes in proptest::collection::vec(0.3..1.0f64, 7),
+        picks in proptest::collection::btree_map(0usize..72, position(), 0..20),
+        strokes in proptest::collection::vec(0.3..1.0f64, 8),
         clamp in proptest::bool::weighted(0.8),
         slower in 1.0..3.0f64,
         lossy in any::<bool>(),
@@ -114,14 +114,17 @@ proptest! {
         fd in any::<bool>(),
     ) {
         // The form, with each node's strokes scaled (the thighs, nodes 7 and 8, alike: they
-        // mirror each other).
+        // mirror each other; the lifts, node 9, too).
         let mut spec = reference().into_spec();
         for a in &mut spec.actuators {
             let factor = strokes[usize::from(a.node.min(7)) - 1];
             a.stroke_mm = (a.stroke_mm * factor * 100.0).round() / 100.0;
         }
+        for lift in &mut spec.lifts {
+            lift.stroke_mm = (lift.stroke_mm * strokes[7] * 100.0).round() / 100.0;
+        }
         let form = FormDescription::try_from(spec).unwrap();
-        let ids: Vec<String> = form.actuators.iter().map(|a| a.id.clone()).collect();
+        let ids: Vec<String> = form.axes().map(|a| a.id.to_string()).collect();
         let positions: BTreeMap<String, f64> =
             picks.iter().map(|(&i, &mm)| (ids[i].clone(), mm)).collect();
         let setpoints = SetPoints::new(form.name.clone(), positions);
@@ -151,7 +154,7 @@ proptest! {
         let slots = check_targets(&form, &sent).map_err(TestCaseError::fail)?;
         // A refused file sends nothing at all.
         let out_of_stroke = setpoints.positions_mm.iter().any(|(id, &mm)| {
-            let stroke = form.actuator(id).unwrap().stroke_mm;
+            let stroke = form.axis(id).unwrap().stroke_mm;
             !(0.0..=stroke).contains(&mm)
         });
         if out_of_stroke && !clamp {

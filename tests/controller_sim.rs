@@ -23,14 +23,13 @@ use form_sim::fault::FaultSpec;
 use form_sim::robot::{SimOptions, SimulatedForm};
 use tokio::time::Instant;
 
-/// Every actuator of the reference form somewhere in its stroke (a different place each).
+/// Every actuator and lift of `form` somewhere in its stroke (a different place each).
 fn full_form_setpoints(form: &FormDescription) -> SetPoints {
     let positions: BTreeMap<String, f64> = form
-        .actuators
-        .iter()
+        .axes()
         .enumerate()
         .map(|(i, a)| {
-            (a.id.clone(), (a.stroke_mm * (0.2 + 0.1 * (i % 7) as f64) * 100.0).round() / 100.0)
+            (a.id.to_string(), (a.stroke_mm * (0.2 + 0.1 * (i % 7) as f64) * 100.0).round() / 100.0)
         })
         .collect();
     SetPoints::new(form.name.clone(), positions)
@@ -40,16 +39,23 @@ fn config(kind: CanKind, faults: &str) -> SimConfig {
     SimConfig { kind, faults: faults.parse().unwrap(), ..SimConfig::default() }
 }
 
+/// Both built-in forms (the reference and the male one), every panel actuator and lift moved.
 #[tokio::test(start_paused = true)]
 async fn a_full_form_update_converges_on_classic_can_and_fd() {
-    let form = reference();
-    let setpoints = full_form_setpoints(&form);
+    for (name, _) in form_description::BUILTIN {
+        full_form_update_converges(&form_description::builtin(name).unwrap()).await;
+    }
+}
+
+async fn full_form_update_converges(form: &FormDescription) {
+    let setpoints = full_form_setpoints(form);
+    let count = form.axes().count();
     for kind in [CanKind::CLASSIC_1M, CanKind::FD_1M_5M] {
         let (report, truth) =
-            drive_on_sim(&form, &setpoints, &DriveOptions::default(), &config(kind, ""), |_| {})
+            drive_on_sim(form, &setpoints, &DriveOptions::default(), &config(kind, ""), |_| {})
                 .await
                 .unwrap();
-        assert_eq!(report.actuators.len(), 64);
+        assert_eq!(report.actuators.len(), count, "{}", form.name);
         assert!(report.converged(), "{report:?}");
         for a in &report.actuators {
             let real = truth.actuator(&a.id).unwrap().state.position_mm;
@@ -58,7 +64,7 @@ async fn a_full_form_update_converges_on_classic_can_and_fd() {
         }
         // All arrive together: at most one feedback period (+ the check's granularity) apart.
         let settled: Vec<u64> = report.actuators.iter().filter_map(|a| a.settled_ms).collect();
-        assert_eq!(settled.len(), 64);
+        assert_eq!(settled.len(), count);
         assert!(report.warnings.is_empty(), "{:?}", report.warnings);
         // The move lasts the shortest common duration: the longest distance at the limits.
         assert!(report.duration_ms > 0 && report.duration_ms < 10_000, "{}", report.duration_ms);
@@ -230,17 +236,17 @@ async fn nodes_that_differ_from_the_description_are_named() {
     let bus = CanBus::new(CanKind::CLASSIC_1M);
     let _simulated =
         SimulatedForm::on_can(&real, &bus, &FaultSpec::default(), &SimOptions::default()).unwrap();
-    // The host's description: node 2's strokes differ, node 9 does not exist, node 8 is left
+    // The host's description: node 2's strokes differ, node 10 does not exist, node 8 is left
     // out (so it is unexpected).
     let mut described = real.clone().into_spec();
     for a in described.actuators.iter_mut().filter(|a| a.node == 2) {
         a.stroke_mm = 55.0;
     }
     for a in described.actuators.iter_mut().filter(|a| a.node == 8) {
-        a.node = 9;
+        a.node = 10;
     }
     for n in described.nodes.iter_mut().filter(|n| n.address == 8) {
-        n.address = 9;
+        n.address = 10;
     }
     let described = FormDescription::try_from(described).unwrap();
     let setpoints = SetPoints::new(real.name.clone(), BTreeMap::new());
@@ -254,7 +260,7 @@ async fn nodes_that_differ_from_the_description_are_named() {
     .await
     .unwrap_err();
     let DriveError::Session(SessionError::Discovery(problems)) = &error else { panic!("{error}") };
-    assert!(problems.contains(&NodeProblem::Missing(9)), "{error}");
+    assert!(problems.contains(&NodeProblem::Missing(10)), "{error}");
     assert!(problems.contains(&NodeProblem::Unexpected(8)), "{error}");
     assert!(
         problems.iter().any(|p| matches!(p, NodeProblem::Mismatch { node: 2, what: "stroke", .. })),

@@ -1,18 +1,21 @@
 //! Fitting the reference form to synthetic customers: inside the form's range every ring's girth
 //! matches the mannequin's within 2 mm with identical left/right set-points; beyond it, the
-//! saturated rings and their excess are reported and no set-point leaves its stroke.
+//! saturated rings and their excess are reported and no set-point leaves its stroke. The lifts
+//! bring every ring to its body level, and the form stands closer to the mannequin than it
+//! did with its rings at fixed heights (issue 31).
 
 use capture_sim::{BodyParams, generate};
 use dressform::body::mesh::Mesh;
 use dressform::body::scan::{self, frame::FrameOptions};
-use dressform::form::form_fit::{Placement, RingStatus, fit, fit_by};
+use dressform::form::form_fit::{Placement, RingFit, RingStatus, fit, fit_by};
 use dressform::run::pipeline::symmetrize;
 use dressform::shape::mannequin::MannequinOptions;
 use dressform::shape::profiles::Profiles;
-use form_description::reference;
+use form_description::{Anchor, FormDescription, reference};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::path::Path;
+use std::sync::OnceLock;
 
 /// The most the skin of a ring may stand off a customer's mannequin inside the form's range,
 /// RMS all round (mm): the reference form's shoulders ring measured 21-22 mm on the default
@@ -32,6 +35,15 @@ fn profiles_of(params: &BodyParams) -> Profiles {
 
 fn assert_within_strokes(fit: &dressform::form::form_fit::FormFit) {
     let form = reference();
+    for lift in &form.lifts {
+        let e = fit.positions_mm[&lift.id];
+        assert!(
+            (0.0..=lift.stroke_mm).contains(&e),
+            "{} at {e} outside 0..={}",
+            lift.id,
+            lift.stroke_mm
+        );
+    }
     for a in &form.actuators {
         let e = fit.positions_mm[&a.id];
         assert!((0.0..=a.stroke_mm).contains(&e), "{} at {e} outside 0..={}", a.id, a.stroke_mm);
@@ -78,10 +90,10 @@ fn customers_inside_the_range_are_matched_within_2_mm_at_every_ring() {
             let panels = form.actuators.iter().filter(|a| a.ring == ring.ring);
             assert_eq!(panels.count(), ring.panel_gaps_mm.len());
         }
-        // Anchored rings sit on their levels: chest, waist, hip at offset 0 from their level.
-        for name in ["chest", "waist", "hip"] {
-            let ring = fit.rings.iter().find(|r| r.ring == name).unwrap();
-            assert!(ring.anchor.is_some());
+        // Every ring is set to a body level, and the lifts bring it there.
+        for ring in &fit.rings {
+            assert!(ring.anchor.is_some(), "{}", ring.ring);
+            assert!(ring.offset_mm.abs() < 0.01, "{}: {:.3} mm off", ring.ring, ring.offset_mm);
         }
     }
 }
@@ -120,19 +132,29 @@ fn arm(abduction: f64) -> capture_sim::ArmPose {
     capture_sim::ArmPose { abduction_deg: abduction, ..capture_sim::Pose::a_pose().left_arm }
 }
 
+/// The profiles of the default customer and of 20 random ones (1.50-1.95 m), made once for
+/// the tests that share them.
+fn customers() -> &'static [Profiles] {
+    static CUSTOMERS: OnceLock<Vec<Profiles>> = OnceLock::new();
+    CUSTOMERS.get_or_init(|| {
+        let params: Vec<BodyParams> =
+            std::iter::once(BodyParams::default()).chain((0..20).map(BodyParams::random)).collect();
+        params.par_iter().map(profiles_of).collect()
+    })
+}
+
 /// The least-squares placement against the common offset (each panel's centre on the section,
-/// all moved out by one offset to the girth) on 20 random customers (1.55-1.95 m): at every
+/// all moved out by one offset to the girth) on 20 random customers (1.50-1.95 m): at every
 /// ring whose girth the form takes, the girth is exact both ways and the skin's RMS gap to the
 /// mannequin all round is never larger by least squares; over the rings it is smaller.
 #[test]
 fn least_squares_places_the_skin_closer_than_one_offset_on_twenty_customers() {
     let form = reference();
-    let fits: Vec<_> = (0..20)
-        .into_par_iter()
-        .map(|s| {
-            let profiles = profiles_of(&BodyParams::random(s));
-            let ls = fit_by(&profiles, &form, Placement::LeastSquares).unwrap();
-            let offset = fit_by(&profiles, &form, Placement::CommonOffset).unwrap();
+    let fits: Vec<_> = customers()[1..]
+        .par_iter()
+        .map(|profiles| {
+            let ls = fit_by(profiles, &form, Placement::LeastSquares).unwrap();
+            let offset = fit_by(profiles, &form, Placement::CommonOffset).unwrap();
             assert_within_strokes(&ls);
             (ls, offset)
         })
@@ -140,7 +162,7 @@ fn least_squares_places_the_skin_closer_than_one_offset_on_twenty_customers() {
     let mut sums = vec![(0.0, 0.0, 0usize); form.rings.len()];
     for (ls, offset) in &fits {
         for (k, (a, b)) in ls.rings.iter().zip(&offset.rings).enumerate() {
-            if !matches!(b.status(), RingStatus::Ok | RingStatus::ShapeLimited) {
+            if !in_range(b) {
                 continue;
             }
             assert!((a.form_girth_mm - a.mannequin_girth_mm).abs() < 0.1, "{}", a.ring);
@@ -166,4 +188,82 @@ fn least_squares_places_the_skin_closer_than_one_offset_on_twenty_customers() {
     }
     eprintln!("all rings: {:.2} -> {:.2} mm", before.sqrt(), after.sqrt());
     assert!(after < before, "least squares no closer over all rings");
+}
+
+/// Whether the form takes a ring's girth (its panels' strokes reach the mannequin's section).
+fn in_range(ring: &RingFit) -> bool {
+    matches!(ring.status(), RingStatus::Ok | RingStatus::ShapeLimited)
+}
+
+/// The reference form as it was before it had lifts (issue 31's "today"): the same panels,
+/// its rings at fixed heights (neck 1480, shoulders 1420, chest 1280, under-bust 1200, waist
+/// 1080, abdomen 1000, hip 900, thighs 720 mm), set to the neck, chest, waist and hip levels
+/// and the others between them.
+fn form_before_lifts() -> FormDescription {
+    let mut spec = reference().into_spec();
+    let lift_nodes: Vec<u8> = spec.lifts.iter().map(|l| l.node).collect();
+    spec.lifts.clear();
+    spec.nodes.retain(|n| !lift_nodes.contains(&n.address));
+    for ring in &mut spec.rings {
+        (ring.height_mm, ring.anchor) = match ring.name.as_str() {
+            "neck" => (1480.0, Some(Anchor::Neck)),
+            "shoulders" => (1420.0, None),
+            "chest" => (1280.0, Some(Anchor::Chest)),
+            "under-bust" => (1200.0, None),
+            "waist" => (1080.0, Some(Anchor::Waist)),
+            "abdomen" => (1000.0, None),
+            "hip" => (900.0, Some(Anchor::Hip)),
+            _ => (720.0, None),
+        };
+    }
+    FormDescription::try_from(spec).unwrap()
+}
+
+/// Issue 31's acceptance on the default customer and 20 random ones (1.50-1.95 m): every
+/// ring within 5 mm of its body level (the strokes allow it for all of them), the girth within
+/// 1 mm wherever the panels reach it, and the RMS radial gap between the form's skin and the
+/// mannequin where each ring stands at least 30% lower than before the form had lifts (rings
+/// at fixed heights, panels by one common offset), over every ring of every customer.
+#[test]
+fn the_form_takes_every_body_level_and_stands_a_third_closer_than_before() {
+    let (form, before) = (reference(), form_before_lifts());
+    let fits: Vec<_> = customers()
+        .par_iter()
+        .map(|profiles| {
+            let after = fit(profiles, &form).unwrap();
+            let then = fit_by(profiles, &before, Placement::CommonOffset).unwrap();
+            // Without lifts a ring stands where it is built: its height is reported, not
+            // judged.
+            assert!(then.target_heights().is_empty());
+            assert_eq!(after.target_heights().len(), form.rings.len());
+            assert_within_strokes(&after);
+            (after, then)
+        })
+        .collect();
+    let (mut after_sq, mut before_sq) = (vec![0.0; form.rings.len()], vec![0.0; form.rings.len()]);
+    for (after, then) in &fits {
+        for (k, (a, b)) in after.rings.iter().zip(&then.rings).enumerate() {
+            assert!(a.offset_mm.abs() <= 5.0, "{} {:.1} mm off its level", a.ring, a.offset_mm);
+            if in_range(a) {
+                let error = a.form_girth_mm - a.mannequin_girth_mm;
+                assert!(error.abs() <= 1.0, "{}: girth {error:+.2} mm", a.ring);
+            }
+            after_sq[k] += a.rms_radial_gap_mm.powi(2);
+            before_sq[k] += b.rms_radial_gap_mm.powi(2);
+        }
+    }
+    let n = fits.len() as f64;
+    eprintln!("ring         RMS radial gap (mm): before  after  change");
+    for (ring, (a, b)) in form.rings.iter().zip(after_sq.iter().zip(&before_sq)) {
+        let (a, b) = ((a / n).sqrt(), (b / n).sqrt());
+        eprintln!("{:<12} {b:>27.1} {a:>6.1} {:>6.0}%", ring.name, 100.0 * (a / b - 1.0));
+    }
+    // Over every ring of every customer (the quadratic mean), and without the neck.
+    let all = |sq: &[f64]| (sq.iter().sum::<f64>() / (n * sq.len() as f64)).sqrt();
+    let (after, before) = (all(&after_sq), all(&before_sq));
+    let (after_body, before_body) = (all(&after_sq[1..]), all(&before_sq[1..]));
+    eprintln!(
+        "all rings: {before:.1} -> {after:.1} mm; without the neck {before_body:.1} -> {after_body:.1}"
+    );
+    assert!(after <= 0.7 * before, "the gaps fell from {before:.1} to {after:.1} mm only");
 }

@@ -45,7 +45,7 @@ fn run_over(transport: PtyLink, flag: &str) {
 
     let form = reference();
     let setpoints = SetPoints::load(&out.join("setpoints.json"), &form).unwrap();
-    assert_eq!(setpoints.positions_mm.len(), form.actuators.len());
+    assert_eq!(setpoints.positions_mm.len(), form.axes().count());
     let truth = server.form().state();
     for (id, &mm) in &setpoints.positions_mm {
         let real = truth.actuator(id).unwrap().state.position_mm;

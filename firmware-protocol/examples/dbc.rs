@@ -1,4 +1,4 @@
-//! Prints the DBC file for a form with nodes 1..=N (default 8, the reference form):
+//! Prints the DBC file for a form with nodes 1..=N (default 9, the reference form):
 //!
 //! ```sh
 //! cargo run -p firmware-protocol --example dbc -- 12 > my-form.dbc
@@ -8,10 +8,10 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     let nodes = match std::env::args().nth(1).map(|n| n.parse::<u8>()) {
-        None => 8,
+        None => 9,
         Some(Ok(n @ 1..=63)) => n,
         Some(_) => {
-            eprintln!("usage: dbc [NODES]   (NODES in 1..=63, default 8)");
+            eprintln!("usage: dbc [NODES]   (NODES in 1..=63, default 9)");
             return ExitCode::FAILURE;
         }
     };

@@ -4,7 +4,7 @@
 //! as in the [`payload`](crate::payload) layouts, raw values as on the wire, and a factor of
 //! 10^-decimals to physical units. [`write()`] renders it as a DBC file for nodes 1..=n (a DBC
 //! lists CAN ids, and ours contain the node). The committed `firmware-protocol/dressform.dbc`
-//! is `write` for the reference form's 8 nodes, and the tests keep it so: they regenerate it,
+//! is `write` for the reference form's 9 nodes, and the tests keep it so: they regenerate it,
 //! check with [`signal_values`] that the encoder puts every field where the DBC says, and
 //! have cantools decode and encode frames with it.
 

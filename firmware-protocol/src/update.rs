@@ -7,9 +7,9 @@
 //! set-points cannot share a frame with another node's (the id names one node), so
 //!
 //! * classic CAN: one 8-byte `Targets` frame per half-node with something to move
-//!   (⌈2·k / 8⌉ per node moving k actuators), plus the SYNC: **17 frames** for the reference
-//!   form (64 actuators on 8 nodes);
-//! * CAN FD and serial: one 16-byte `AllTargets` per node, plus the SYNC: **9 frames**.
+//!   (⌈2·k / 8⌉ per node moving k actuators), plus the SYNC: **19 frames** for the reference
+//!   form (72 actuators, lifts included, on 9 nodes);
+//! * CAN FD and serial: one 16-byte `AllTargets` per node, plus the SYNC: **10 frames**.
 //!
 //! A duration is feasible for an actuator when it is at least [`shortest_duration_ms`] for
 //! the distance and the actuator's limits; host and node use this one formula.

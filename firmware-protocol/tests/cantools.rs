@@ -30,10 +30,10 @@ fn cantools_available() -> bool {
     .is_some()
 }
 
-/// Deterministic packets for the DBC's nodes 1..=8.
+/// Deterministic packets for the DBC's nodes 1..=9.
 fn packets() -> Vec<Packet> {
     let mut runner = TestRunner::deterministic();
-    let strategy = strategies::packet(1..=8);
+    let strategy = strategies::packet(1..=9);
     (0..CASES).map(|_| strategy.new_tree(&mut runner).unwrap().current()).collect()
 }
 

@@ -1,6 +1,7 @@
 //! The description's types: what a file says ([`FormSpec`], unchecked) and the validated
 //! [`FormDescription`]; look-ups and geometry.
 
+use std::collections::BTreeMap;
 use std::ops::Deref;
 
 use firmware_protocol::{Accel, Actuator, NodeId, Position, Speed};
@@ -27,9 +28,12 @@ pub struct FormSpec {
     /// Horizontal rows of actuators (`[[ring]]`).
     #[serde(rename = "ring", default)]
     pub rings: Vec<RingSpec>,
-    /// The actuators (`[[actuator]]`).
+    /// The actuators that push panels out of the rings (`[[actuator]]`).
     #[serde(rename = "actuator", default)]
     pub actuators: Vec<ActuatorSpec>,
+    /// The height axes that raise rings (`[[lift]]`); a form may have none.
+    #[serde(rename = "lift", default, skip_serializing_if = "Vec::is_empty")]
+    pub lifts: Vec<LiftSpec>,
 }
 
 /// One node (controller board).
@@ -49,7 +53,7 @@ pub struct NodeSpec {
 pub struct RingSpec {
     /// Its name (`neck`, `chest`, `thigh-l`, ...).
     pub name: String,
-    /// Height above the floor, mm.
+    /// Height above the floor with every lift retracted, mm ([`FormSpec::ring_height`]).
     pub height_mm: f64,
     /// The ring's axis in the X-Y plane, mm: `[0, 0]` (the body axis) unless off-centre,
     /// like a thigh.
@@ -96,18 +100,27 @@ impl BodyPart {
     }
 }
 
-/// A mannequin level a ring can be set to (each at most once per form).
+/// A body level a ring can be set to (each at most once per form; the host defines where each
+/// lies on a mannequin). The torso's levels, top to bottom, then the thigh's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "kebab-case")]
 pub enum Anchor {
     /// The neck landmark.
     Neck,
+    /// The shoulders: between the neck and the armpits.
+    Shoulders,
     /// The chest level.
     Chest,
+    /// The fold under the bust.
+    UnderBust,
     /// The waist level.
     Waist,
+    /// The abdomen: midway between the waist and the hip.
+    Abdomen,
     /// The hip level.
     Hip,
+    /// The thigh girth's level, just under the crotch (a leg level: both thigh rings).
+    Thigh,
 }
 
 impl Anchor {
@@ -115,10 +128,19 @@ impl Anchor {
     pub fn name(self) -> &'static str {
         match self {
             Anchor::Neck => "neck",
+            Anchor::Shoulders => "shoulders",
             Anchor::Chest => "chest",
+            Anchor::UnderBust => "under-bust",
             Anchor::Waist => "waist",
+            Anchor::Abdomen => "abdomen",
             Anchor::Hip => "hip",
+            Anchor::Thigh => "thigh",
         }
+    }
+
+    /// Whether it is a leg's level (set on both legs' rings) rather than the torso's.
+    pub fn is_leg(self) -> bool {
+        self == Anchor::Thigh
     }
 }
 
@@ -156,7 +178,78 @@ pub struct ActuatorSpec {
     pub mirror: Option<String>,
 }
 
-impl ActuatorSpec {
+/// A height axis: a linear actuator that raises the rings it carries by its extension. A
+/// ring's height is its `height_mm` plus the extensions of every lift carrying it, so lifts
+/// stack: a column under the whole form, a torso-length axis above the waist, ... On the bus a
+/// lift is one more actuator (an [`Axis`]): the same messages, limits and safety rules.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LiftSpec {
+    /// Stable id (`torso-length`), unique among actuators and lifts.
+    pub id: String,
+    /// Address of the node driving it.
+    pub node: u8,
+    /// Its index on that node, 0..=7 (numbered with the node's actuators).
+    pub channel: u8,
+    /// The rings it raises.
+    pub rings: Vec<String>,
+    /// Travel upwards from fully retracted (0), mm.
+    pub stroke_mm: f64,
+    /// Speed limit, mm/s.
+    pub max_speed_mm_s: f64,
+    /// Acceleration (and deceleration) limit, mm/s².
+    pub max_accel_mm_s2: f64,
+    /// Id of its mirror partner, for a lift raising rings on one side only (a left thigh's
+    /// names the right thigh's); a lift raising both sides alike is its own mirror.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mirror: Option<String>,
+}
+
+/// What the bus knows of an actuator, a panel's or a lift's alike: where it is, how far and
+/// how fast it may move. The controller and the simulated nodes see a form as these.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Axis<'a> {
+    /// Its id.
+    pub id: &'a str,
+    /// Address of the node driving it.
+    pub node: u8,
+    /// Its index on that node.
+    pub channel: u8,
+    /// Travel from fully retracted (0), mm.
+    pub stroke_mm: f64,
+    /// Speed limit, mm/s.
+    pub max_speed_mm_s: f64,
+    /// Acceleration (and deceleration) limit, mm/s².
+    pub max_accel_mm_s2: f64,
+}
+
+impl<'a> From<&'a ActuatorSpec> for Axis<'a> {
+    fn from(a: &'a ActuatorSpec) -> Self {
+        Axis {
+            id: &a.id,
+            node: a.node,
+            channel: a.channel,
+            stroke_mm: a.stroke_mm,
+            max_speed_mm_s: a.max_speed_mm_s,
+            max_accel_mm_s2: a.max_accel_mm_s2,
+        }
+    }
+}
+
+impl<'a> From<&'a LiftSpec> for Axis<'a> {
+    fn from(l: &'a LiftSpec) -> Self {
+        Axis {
+            id: &l.id,
+            node: l.node,
+            channel: l.channel,
+            stroke_mm: l.stroke_mm,
+            max_speed_mm_s: l.max_speed_mm_s,
+            max_accel_mm_s2: l.max_accel_mm_s2,
+        }
+    }
+}
+
+impl Axis<'_> {
     /// The stroke as a protocol position (0.01 mm).
     pub fn stroke(&self) -> Position {
         Position::from_mm(self.stroke_mm as f32).unwrap_or(Position::ZERO)
@@ -181,7 +274,9 @@ impl ActuatorSpec {
     pub fn actuator(&self) -> Option<Actuator> {
         Actuator::new(self.channel)
     }
+}
 
+impl ActuatorSpec {
     /// The unit vector, in the X-Y plane, along which its panel moves out.
     pub fn direction(&self) -> [f64; 2] {
         let angle = self.angle_deg.to_radians();
@@ -211,17 +306,43 @@ impl FormSpec {
         self.nodes.iter().filter_map(|n| NodeId::new(n.address))
     }
 
-    /// The actuators of a node, by channel.
-    pub fn actuators_of(&self, node: NodeId) -> Vec<&ActuatorSpec> {
-        let mut actuators: Vec<_> =
-            self.actuators.iter().filter(|a| a.node == node.get()).collect();
-        actuators.sort_by_key(|a| a.channel);
-        actuators
+    /// Every actuator on the bus: the panels' (`[[actuator]]`), then the lifts.
+    pub fn axes(&self) -> impl Iterator<Item = Axis<'_>> {
+        self.actuators.iter().map(Axis::from).chain(self.lifts.iter().map(Axis::from))
     }
 
-    /// The actuator with this id.
+    /// The actuator or lift with this id, as the bus knows it.
+    pub fn axis(&self, id: &str) -> Option<Axis<'_>> {
+        self.axes().find(|a| a.id == id)
+    }
+
+    /// The actuators and lifts of a node, by channel.
+    pub fn actuators_of(&self, node: NodeId) -> Vec<Axis<'_>> {
+        let mut axes: Vec<_> = self.axes().filter(|a| a.node == node.get()).collect();
+        axes.sort_by_key(|a| a.channel);
+        axes
+    }
+
+    /// The panel actuator with this id.
     pub fn actuator(&self, id: &str) -> Option<&ActuatorSpec> {
         self.actuators.iter().find(|a| a.id == id)
+    }
+
+    /// The lift with this id.
+    pub fn lift(&self, id: &str) -> Option<&LiftSpec> {
+        self.lifts.iter().find(|l| l.id == id)
+    }
+
+    /// A ring's height above the floor with the lifts at `positions_mm` (id → extension;
+    /// missing lifts count as retracted): its `height_mm` plus every carrying lift's extension.
+    pub fn ring_height(&self, ring: &RingSpec, positions_mm: &BTreeMap<String, f64>) -> f64 {
+        let lifted = self.lifts_of(&ring.name).map(|l| positions_mm.get(&l.id).copied());
+        ring.height_mm + lifted.map(|e| e.unwrap_or(0.0)).sum::<f64>()
+    }
+
+    /// The lifts that carry `ring`.
+    pub fn lifts_of<'a>(&'a self, ring: &'a str) -> impl Iterator<Item = &'a LiftSpec> + 'a {
+        self.lifts.iter().filter(move |l| l.rings.iter().any(|r| r == ring))
     }
 
     /// The ring with this name.
@@ -229,15 +350,15 @@ impl FormSpec {
         self.rings.iter().find(|r| r.name == name)
     }
 
-    /// Where an actuator is on the bus: its node and index.
+    /// Where an actuator or lift is on the bus: its node and index.
     pub fn locate(&self, id: &str) -> Option<(NodeId, Actuator)> {
-        let actuator = self.actuator(id)?;
-        Some((actuator.node_id()?, actuator.actuator()?))
+        let axis = self.axis(id)?;
+        Some((axis.node_id()?, axis.actuator()?))
     }
 
-    /// The actuator at this node and index.
-    pub fn actuator_at(&self, node: NodeId, actuator: Actuator) -> Option<&ActuatorSpec> {
-        self.actuators.iter().find(|a| a.node == node.get() && a.actuator() == Some(actuator))
+    /// The actuator or lift at this node and index.
+    pub fn actuator_at(&self, node: NodeId, actuator: Actuator) -> Option<Axis<'_>> {
+        self.axes().find(|a| a.node == node.get() && a.actuator() == Some(actuator))
     }
 
     /// An actuator's mirror partner: the one it names, the one naming it, or itself for a
@@ -251,7 +372,7 @@ impl FormSpec {
     }
 
     /// Where an actuator's panel centre is, in the canonical frame (mm), at `extension_mm`
-    /// from retracted.
+    /// from retracted, with the lifts retracted.
     pub fn panel_position(&self, id: &str, extension_mm: f64) -> Option<[f64; 3]> {
         let actuator = self.actuator(id)?;
         let ring = self.ring(&actuator.ring)?;

@@ -9,12 +9,33 @@ use super::validate::Problem;
 /// The reference form's description, as shipped in `forms/reference.toml`.
 pub const REFERENCE_TOML: &str = include_str!("../forms/reference.toml");
 
-/// The shipped reference form: 64 actuators on 8 nodes from neck to mid-thigh (see
-/// `form-description/README.md` for its layout).
+/// The male reference form's description, as shipped in `forms/male.toml`.
+pub const MALE_TOML: &str = include_str!("../forms/male.toml");
+
+/// The built-in forms by name, with their descriptions: `reference` (the default) and
+/// `male`.
+pub const BUILTIN: [(&str, &str); 2] = [("reference", REFERENCE_TOML), ("male", MALE_TOML)];
+
+/// The shipped reference form: 64 panel actuators on 8 nodes from neck to mid-thigh and 8
+/// lifts on a ninth (see `form-description/README.md` for its layout).
 pub fn reference() -> FormDescription {
-    // The file is part of the crate and a test checks it validates.
-    FormDescription::from_toml_str(REFERENCE_TOML)
-        .unwrap_or_else(|error| unreachable!("the shipped reference form is invalid: {error}"))
+    builtin("reference").unwrap_or_else(|| unreachable!("the reference form is built in"))
+}
+
+/// The description file of the built-in form named `name` (see [`BUILTIN`]), with its
+/// comments, if there is one.
+pub fn builtin_toml(name: &str) -> Option<&'static str> {
+    BUILTIN.iter().find(|(n, _)| *n == name).map(|(_, text)| *text)
+}
+
+/// The built-in form named `name` (see [`BUILTIN`]), if there is one.
+pub fn builtin(name: &str) -> Option<FormDescription> {
+    let text = builtin_toml(name)?;
+    // The files are part of the crate and a test checks they validate.
+    Some(
+        FormDescription::from_toml_str(text)
+            .unwrap_or_else(|error| unreachable!("the built-in form {name} is invalid: {error}")),
+    )
 }
 
 impl FormDescription {

@@ -1,12 +1,12 @@
 //! Validation of a form description: every problem, each naming what and where.
 
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::fmt;
 
 use firmware_protocol::actuator::MAX_ACTUATORS;
 use firmware_protocol::{HUNDREDTHS_PER_MM, NodeId, Position, TENTHS_PER_MM_S2};
 
-use super::description::{ActuatorSpec, BodyPart, FormDescription, FormSpec, RingSpec};
+use super::description::{ActuatorSpec, Axis, BodyPart, FormDescription, FormSpec, RingSpec};
 use super::number::number;
 
 /// Smallest stroke, mm: one step of the wire's positions (0.01 mm).
@@ -21,6 +21,11 @@ const MAX_SPEED_MM_S: f64 = 655.35;
 const MAX_ACCEL_MM_S2: f64 = 6553.5;
 /// Tolerance when comparing mirrored quantities (mm, degrees).
 const MIRROR_TOLERANCE: f64 = 1e-6;
+/// The least vertical distance between two rings at any extension of the lifts, mm: a
+/// design margin, not a measured one (a description gives the panels' widths but not their
+/// heights, and two rings closer than a centimetre could not both carry panels). Lifts may not
+/// carry a ring onto or past another.
+pub const MIN_RING_SPACING_MM: f64 = 10.0;
 
 /// One problem found in a form description.
 #[derive(Clone, Debug, PartialEq)]
@@ -153,6 +158,22 @@ pub enum Problem {
         /// The actuator.
         actuator: String,
     },
+    /// A lift's `rings` are empty, unknown or repeated, or its mirror does not mirror it.
+    Lift {
+        /// The lift.
+        lift: String,
+        /// Why.
+        problem: String,
+    },
+    /// Lifts can bring two rings closer than [`MIN_RING_SPACING_MM`] (or past each other).
+    RingsMeet {
+        /// The upper ring (with every lift retracted).
+        upper: String,
+        /// The lower ring.
+        lower: String,
+        /// Their spacing with the lower ring's own lifts extended and the upper's retracted.
+        closest_mm: f64,
+    },
 }
 
 impl fmt::Display for Problem {
@@ -217,6 +238,13 @@ impl fmt::Display for Problem {
                 "actuator `{actuator}`: off the centre line and without a mirror partner \
                  (name it with `mirror`)"
             ),
+            Self::Lift { lift, problem } => write!(f, "lift `{lift}`: {problem}"),
+            Self::RingsMeet { upper, lower, closest_mm } => write!(
+                f,
+                "rings `{upper}` and `{lower}`: the lifts can bring them to {} mm apart; keep \
+                 at least {MIN_RING_SPACING_MM} mm (shorten a stroke or raise `{upper}`)",
+                number(*closest_mm)
+            ),
         }
     }
 }
@@ -239,6 +267,8 @@ impl FormSpec {
         self.check_actuators(&mut problems);
         self.check_channels(&mut problems);
         self.check_mirrors(&mut problems);
+        self.check_lifts(&mut problems);
+        self.check_ring_spacing(&mut problems);
         if problems.is_empty() { Ok(()) } else { Err(problems) }
     }
 
@@ -253,7 +283,7 @@ impl FormSpec {
                 problems.push(Problem::NodeAddress { address });
             } else if !seen.insert(address) {
                 problems.push(Problem::DuplicateNode { address });
-            } else if !self.actuators.iter().any(|a| a.node == address) {
+            } else if !self.axes().any(|a| a.node == address) {
                 problems.push(Problem::NodeWithoutActuators { address });
             }
         }
@@ -295,13 +325,18 @@ impl FormSpec {
         }
     }
 
-    /// An anchor on a leg ring, or one another ring (earlier in the file) already has.
+    /// A torso level on a leg ring or a leg's on a torso ring, or one another ring of the same
+    /// part (earlier in the file) already has.
     fn anchor_problem(&self, ring: &RingSpec) -> Option<String> {
         let anchor = ring.anchor?;
-        if ring.part != BodyPart::Torso {
-            return Some(format!("\"{}\" is a torso level; a leg ring has none", anchor.name()));
+        if anchor.is_leg() != (ring.part != BodyPart::Torso) {
+            let (level, other) = if anchor.is_leg() { ("leg", "torso") } else { ("torso", "leg") };
+            return Some(format!(
+                "\"{}\" is a {level} level; a {other} ring has none",
+                anchor.name()
+            ));
         }
-        let first = self.rings.iter().find(|r| r.anchor == Some(anchor))?;
+        let first = self.rings.iter().find(|r| r.anchor == Some(anchor) && r.part == ring.part)?;
         (first.name != ring.name).then(|| {
             format!("\"{}\" is already the anchor of ring `{}`", anchor.name(), first.name)
         })
@@ -343,78 +378,84 @@ impl FormSpec {
         None
     }
 
+    /// Every actuator's and lift's bus fields ([`Self::check_axis`]), and the panels' geometry.
     fn check_actuators(&self, problems: &mut Vec<Problem>) {
         let mut seen = HashSet::new();
+        for axis in self.axes() {
+            self.check_axis(axis, &mut seen, problems);
+        }
         for a in &self.actuators {
-            if !is_valid_id(&a.id) {
-                problems.push(Problem::BadId { id: a.id.clone() });
-            } else if !seen.insert(a.id.as_str()) {
-                problems.push(Problem::DuplicateActuator { id: a.id.clone() });
-            }
-            if !self.nodes.iter().any(|n| n.address == a.node) {
-                problems.push(Problem::UnknownNode { actuator: a.id.clone(), node: a.node });
-            }
             if self.ring(&a.ring).is_none() {
                 problems
                     .push(Problem::UnknownRing { actuator: a.id.clone(), ring: a.ring.clone() });
             }
-            if usize::from(a.channel) >= MAX_ACTUATORS {
-                problems.push(Problem::ChannelOutOfRange {
-                    actuator: a.id.clone(),
-                    channel: a.channel,
-                });
-            }
-            let max_stroke = Position::MAX.mm();
-            let checks: [(&'static str, f64, bool, &'static str); 6] = [
+            let checks: [(&'static str, f64, bool, &'static str); 3] = [
                 ("angle_deg", a.angle_deg, (0.0..360.0).contains(&a.angle_deg), "in [0, 360)"),
                 ("base_radius_mm", a.base_radius_mm, a.base_radius_mm > 0.0, "> 0"),
                 ("panel_width_mm", a.panel_width_mm, a.panel_width_mm > 0.0, "> 0"),
-                (
-                    "stroke_mm",
-                    a.stroke_mm,
-                    a.stroke_mm >= MIN_STROKE_MM && a.stroke_mm <= max_stroke,
-                    "in 0.01..=655.34",
-                ),
-                (
-                    "max_speed_mm_s",
-                    a.max_speed_mm_s,
-                    a.max_speed_mm_s >= MIN_SPEED_MM_S && a.max_speed_mm_s <= MAX_SPEED_MM_S,
-                    "in 0.01..=655.35",
-                ),
-                (
-                    "max_accel_mm_s2",
-                    a.max_accel_mm_s2,
-                    a.max_accel_mm_s2 >= MIN_ACCEL_MM_S2 && a.max_accel_mm_s2 <= MAX_ACCEL_MM_S2,
-                    "in 0.1..=6553.5",
-                ),
             ];
-            for (field, value, ok, expected) in checks {
-                // NaN fails every comparison above, infinities fail the ranges.
-                if !(ok && value.is_finite()) {
-                    problems.push(Problem::Value {
-                        actuator: a.id.clone(),
-                        field,
-                        value,
-                        expected,
-                    });
-                }
-            }
+            push_values(&a.id, checks, problems);
         }
+    }
+
+    /// An actuator's or lift's id, node, channel, stroke and limits.
+    fn check_axis<'a>(
+        &self,
+        a: Axis<'a>,
+        seen: &mut HashSet<&'a str>,
+        problems: &mut Vec<Problem>,
+    ) {
+        if !is_valid_id(a.id) {
+            problems.push(Problem::BadId { id: a.id.to_string() });
+        } else if !seen.insert(a.id) {
+            problems.push(Problem::DuplicateActuator { id: a.id.to_string() });
+        }
+        if !self.nodes.iter().any(|n| n.address == a.node) {
+            problems.push(Problem::UnknownNode { actuator: a.id.to_string(), node: a.node });
+        }
+        if usize::from(a.channel) >= MAX_ACTUATORS {
+            problems.push(Problem::ChannelOutOfRange {
+                actuator: a.id.to_string(),
+                channel: a.channel,
+            });
+        }
+        let max_stroke = Position::MAX.mm();
+        let checks: [(&'static str, f64, bool, &'static str); 3] = [
+            (
+                "stroke_mm",
+                a.stroke_mm,
+                a.stroke_mm >= MIN_STROKE_MM && a.stroke_mm <= max_stroke,
+                "in 0.01..=655.34",
+            ),
+            (
+                "max_speed_mm_s",
+                a.max_speed_mm_s,
+                a.max_speed_mm_s >= MIN_SPEED_MM_S && a.max_speed_mm_s <= MAX_SPEED_MM_S,
+                "in 0.01..=655.35",
+            ),
+            (
+                "max_accel_mm_s2",
+                a.max_accel_mm_s2,
+                a.max_accel_mm_s2 >= MIN_ACCEL_MM_S2 && a.max_accel_mm_s2 <= MAX_ACCEL_MM_S2,
+                "in 0.1..=6553.5",
+            ),
+        ];
+        push_values(a.id, checks, problems);
     }
 
     fn check_channels(&self, problems: &mut Vec<Problem>) {
         let mut by_node: BTreeMap<u8, BTreeMap<u8, &str>> = BTreeMap::new();
-        for a in self.actuators.iter().filter(|a| usize::from(a.channel) < MAX_ACTUATORS) {
+        for a in self.axes().filter(|a| usize::from(a.channel) < MAX_ACTUATORS) {
             let channels = by_node.entry(a.node).or_default();
             if let Some(first) = channels.get(&a.channel) {
                 problems.push(Problem::ChannelTaken {
                     node: a.node,
                     channel: a.channel,
                     first: first.to_string(),
-                    second: a.id.clone(),
+                    second: a.id.to_string(),
                 });
             } else {
-                channels.insert(a.channel, &a.id);
+                channels.insert(a.channel, a.id);
             }
         }
         for (address, channels) in by_node {
@@ -464,6 +505,114 @@ impl FormSpec {
         }
     }
 
+    /// Each lift's rings (known, not repeated) and mirror rule: a lift raising rings on one
+    /// side names a partner raising the mirror rings with the same stroke and limits; one
+    /// without a partner raises both sides alike.
+    fn check_lifts(&self, problems: &mut Vec<Problem>) {
+        for lift in &self.lifts {
+            let mut problem = |problem: String| {
+                problems.push(Problem::Lift { lift: lift.id.clone(), problem });
+            };
+            if lift.rings.is_empty() {
+                problem("`rings` is empty: name the rings it raises".into());
+            }
+            for (k, name) in lift.rings.iter().enumerate() {
+                if self.ring(name).is_none() {
+                    problem(format!("`rings` names \"{name}\", not a `[[ring]]` name"));
+                } else if lift.rings[..k].contains(name) {
+                    problem(format!("`rings` names `{name}` twice"));
+                }
+            }
+            let named_by: Vec<&str> = (self.lifts.iter())
+                .filter(|m| m.mirror.as_deref() == Some(lift.id.as_str()))
+                .map(|m| m.id.as_str())
+                .collect();
+            let partners: BTreeSet<&str> =
+                lift.mirror.iter().map(String::as_str).chain(named_by.iter().copied()).collect();
+            if let [a, b, ..] = partners.iter().collect::<Vec<_>>()[..] {
+                problem(format!("paired as the mirror of both `{a}` and `{b}`"));
+                continue;
+            }
+            let partner = match (&lift.mirror, named_by.first()) {
+                (Some(name), _) => match self.lift(name) {
+                    Some(partner) => partner,
+                    None => {
+                        problem(format!("`mirror` \"{name}\" is not a lift"));
+                        continue;
+                    }
+                },
+                (None, Some(_)) => continue, // checked from the side naming the pair
+                (None, None) => lift,
+            };
+            // The partner raises exactly the mirror images of this lift's rings.
+            let mirrored: BTreeSet<&str> = lift.rings.iter().map(|r| self.mirror_ring(r)).collect();
+            let theirs: BTreeSet<&str> = partner.rings.iter().map(String::as_str).collect();
+            let by =
+                if partner.id == lift.id { "it".to_string() } else { format!("`{}`", partner.id) };
+            if let Some(ring) = lift.rings.iter().find(|r| !theirs.contains(self.mirror_ring(r))) {
+                problem(format!(
+                    "raises `{ring}` but {by} does not raise its mirror `{}`: raise both sides \
+                     alike or pair the lift with one raising the other side (`mirror`)",
+                    self.mirror_ring(ring)
+                ));
+            } else if let Some(extra) = theirs.difference(&mirrored).next() {
+                problem(format!(
+                    "{by} also raises `{extra}`, whose mirror this lift does not raise: a mirror \
+                     pair raises mirror images"
+                ));
+            }
+            let limits = [
+                ("stroke_mm", lift.stroke_mm, partner.stroke_mm),
+                ("max_speed_mm_s", lift.max_speed_mm_s, partner.max_speed_mm_s),
+                ("max_accel_mm_s2", lift.max_accel_mm_s2, partner.max_accel_mm_s2),
+            ];
+            if let Some((field, x, y)) = limits.iter().find(|(_, x, y)| !close(*x, *y)) {
+                problem(format!(
+                    "its mirror `{}` has another `{field}` ({} and {})",
+                    partner.id,
+                    number(*x),
+                    number(*y)
+                ));
+            }
+        }
+    }
+
+    /// Every two rings at different heights stay [`MIN_RING_SPACING_MM`] apart however the
+    /// lifts stand: the closest they come is with the lower ring's own lifts (those not also
+    /// carrying the upper ring) at full stroke.
+    fn check_ring_spacing(&self, problems: &mut Vec<Problem>) {
+        for upper in &self.rings {
+            for lower in self.rings.iter().filter(|r| r.height_mm < upper.height_mm) {
+                let raised: f64 = self
+                    .lifts_of(&lower.name)
+                    .filter(|l| !l.rings.contains(&upper.name))
+                    .map(|l| l.stroke_mm)
+                    .sum();
+                let closest_mm = upper.height_mm - lower.height_mm - raised;
+                if raised > 0.0 && closest_mm < MIN_RING_SPACING_MM {
+                    problems.push(Problem::RingsMeet {
+                        upper: upper.name.clone(),
+                        lower: lower.name.clone(),
+                        closest_mm,
+                    });
+                }
+            }
+        }
+    }
+
+    /// The ring mirroring `name`: the one it names, the one naming it, or itself (centred).
+    fn mirror_ring<'a>(&'a self, name: &'a str) -> &'a str {
+        let Some(ring) = self.ring(name) else { return name };
+        match &ring.mirror {
+            Some(mirror) => mirror,
+            None => self
+                .rings
+                .iter()
+                .find(|r| r.mirror.as_deref() == Some(name))
+                .map_or(name, |r| r.name.as_str()),
+        }
+    }
+
     /// Whether an actuator is its own mirror: at 0° or 180° on a ring centred on x = 0.
     fn on_centre_line(&self, a: &ActuatorSpec) -> bool {
         let centred = self.ring(&a.ring).is_some_and(|r| r.center_mm[0] == 0.0);
@@ -476,15 +625,8 @@ impl FormSpec {
             return (!self.on_centre_line(a))
                 .then(|| "only centre-line actuators (0° or 180°) mirror themselves".into());
         }
-        let ring = self.ring(&a.ring)?;
-        let mirror_ring = match &ring.mirror {
-            Some(name) => name.clone(),
-            None => self
-                .rings
-                .iter()
-                .find(|r| r.mirror.as_deref() == Some(&ring.name))
-                .map_or_else(|| ring.name.clone(), |r| r.name.clone()),
-        };
+        self.ring(&a.ring)?;
+        let mirror_ring = self.mirror_ring(&a.ring);
         if b.ring != mirror_ring {
             return Some(format!("`{}` is on ring `{}`, expected `{mirror_ring}`", b.id, b.ring));
         }
@@ -509,6 +651,20 @@ impl FormSpec {
             .iter()
             .find(|(_, x, y)| !close(*x, *y))
             .map(|(field, x, y)| format!("`{field}` differs ({} and {})", number(*x), number(*y)))
+    }
+}
+
+/// A [`Problem::Value`] for each `(field, value, ok, expected)` not ok or not finite.
+fn push_values<const N: usize>(
+    id: &str,
+    checks: [(&'static str, f64, bool, &'static str); N],
+    problems: &mut Vec<Problem>,
+) {
+    for (field, value, ok, expected) in checks {
+        // NaN fails every comparison, infinities fail the ranges.
+        if !(ok && value.is_finite()) {
+            problems.push(Problem::Value { actuator: id.to_string(), field, value, expected });
+        }
     }
 }
 

@@ -15,7 +15,7 @@ use dressform::body::mesh::{Mesh, smooth::DEFAULT_PASSES};
 use dressform::body::scan::format::{Export, Format, Placement};
 use dressform::body::scan::{self, PreparedScan, frame::FrameOptions, frame::Units};
 use dressform::form::controller::{DriveOptions, LinkSpec};
-use dressform::form::form_fit::DEFAULT_GIRTH_TOLERANCE_MM;
+use dressform::form::form_fit::Tolerance;
 use dressform::pose::body_model::BodyModel;
 use dressform::run::info::ScanInfo;
 use dressform::run::reconstruct::{MeasurementsReport, ReconstructOptions};
@@ -57,7 +57,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
         link: &LinkSpec::Sim,
         sim: &SimArgs::default(),
         options: &DriveOptions::default(),
-        girth_tolerance: DEFAULT_GIRTH_TOLERANCE_MM,
+        tolerance: Tolerance::default(),
     };
     let form = form_description::reference();
     let (seed, out, legs) = (args.seed, args.out.clone(), args.legs.options());
@@ -97,7 +97,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
     }
     outln!();
     outln!(
-        "Written to {}: scan.ply, posed.obj (the scan re-posed symmetric), rigged.glb, fit.json, mannequin.obj, profiles.json, measurements.json, setpoints.json, preview.png (the scan, the pose-symmetric scan and the mannequin), sections.svg",
+        "Written to {}: scan.ply, posed.obj (the scan re-posed symmetric), rigged.glb, fit.json, mannequin.obj, profiles.json, measurements.json, setpoints.json, form-fit.png (the form over the mannequin), preview.png (the scan, the pose-symmetric scan and the mannequin), sections.svg",
         args.out.display()
     );
     shape_verdict(&shape)

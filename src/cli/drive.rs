@@ -13,7 +13,10 @@ use dressform::form::controller::{
     DEFAULT_TOLERANCE_MM, DriveAfterError, DriveError, DriveOptions, DriveReport, LinkSpec,
     MoveError, Progress, SessionError, drive_after, plan,
 };
-use dressform::form::form_fit::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
+use dressform::form::form_fit::{
+    DEFAULT_GIRTH_TOLERANCE_MM, DEFAULT_HEIGHT_TOLERANCE_MM, ShapeOutcome, Targets, Tolerance,
+    compare,
+};
 use dressform::form::setpoints::SetPoints;
 use dressform::messages;
 use firmware_protocol::Position;
@@ -42,6 +45,10 @@ pub struct ShapeArgs {
     /// and the command exits 3, mm.
     #[arg(long, value_name = "MM", default_value_t = DEFAULT_GIRTH_TOLERANCE_MM)]
     girth_tolerance: f64,
+    /// A ring whose lifts left it off its body level by more than this is off its level and
+    /// the command exits 3, mm.
+    #[arg(long, value_name = "MM", default_value_t = DEFAULT_HEIGHT_TOLERANCE_MM)]
+    height_tolerance: f64,
     /// Clear latched hardware faults (a jam, an overcurrent, a broken encoder...) before
     /// moving; without it only an e-stop and a host timeout are cleared.
     #[arg(long)]
@@ -49,9 +56,12 @@ pub struct ShapeArgs {
 }
 
 impl ShapeArgs {
-    /// The tolerance, checked.
-    pub fn girth_tolerance(&self) -> Result<f64, Failure> {
-        within("--girth-tolerance", self.girth_tolerance, 0.0.., " mm")
+    /// The tolerances, checked.
+    pub fn tolerance(&self) -> Result<Tolerance, Failure> {
+        Ok(Tolerance {
+            girth_mm: within("--girth-tolerance", self.girth_tolerance, 0.0.., " mm")?,
+            height_mm: within("--height-tolerance", self.height_tolerance, 0.0.., " mm")?,
+        })
     }
 
     /// Drive options with `--reset-faults`.
@@ -106,7 +116,7 @@ pub fn run(args: &DriveArgs) -> Result<(), Failure> {
         Some(s) => Duration::from_secs_f64(within("--duration", s, 0.0..=longest_s, " s")?),
         None => Duration::ZERO,
     };
-    let girth_tolerance = args.shape.girth_tolerance()?;
+    let tolerance = args.shape.tolerance()?;
     let form = args.form.load()?;
     let setpoints = SetPoints::load(&args.setpoints, &form).map_err(Failure::bad_input)?;
     let file = args.setpoints.display().to_string();
@@ -119,16 +129,18 @@ pub fn run(args: &DriveArgs) -> Result<(), Failure> {
         min_duration,
         ..args.shape.options()
     };
-    let target_girths = setpoints.target_girths_mm.clone();
+    let (girths_mm, heights_mm) =
+        (setpoints.target_girths_mm.clone(), setpoints.target_heights_mm.clone());
     let compute = move || Ok(((), setpoints));
     let ((), report) = execute(&form, &args.link.spec(), &options, &args.sim, args.json, compute)?;
-    let shape = compare(&form, &report.positions_mm, &target_girths, girth_tolerance);
+    let targets = Targets { girths_mm: &girths_mm, heights_mm: &heights_mm };
+    let shape = compare(&form, &report.positions_mm, targets, tolerance);
     print_report(&report, &shape, args.json)?;
     shape_verdict(&shape)
 }
 
-/// Exit status 3 with a one-line summary when a ring is off its girth by more than the
-/// tolerance: the form could not take the shape.
+/// Exit status 3 with a one-line summary when a ring is off its girth or its level by more
+/// than the tolerance: the form could not take the shape.
 pub fn shape_verdict(shape: &ShapeOutcome) -> Result<(), Failure> {
     match shape.summary() {
         Some(summary) => Err(Failure { message: summary, exit_code: 3 }),
@@ -238,14 +250,27 @@ fn print_report(report: &DriveReport, shape: &ShapeOutcome, json: bool) -> Resul
     } else {
         print_table(report);
         if !shape.rings.is_empty() {
-            outln!("{:<12} {:>10} {:>10} {:>8}  status", "ring", "mannequin", "form", "error");
+            outln!(
+                "{:<12} {:>10} {:>10} {:>8} {:>8} {:>8} {:>8}  status",
+                "ring",
+                "mannequin",
+                "form",
+                "error",
+                "level",
+                "height",
+                "error"
+            );
+            let mm = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
             for r in &shape.rings {
                 outln!(
-                    "{:<12} {:>10.1} {:>10.1} {:>8.1}  {}",
+                    "{:<12} {:>10} {:>10.1} {:>8.1} {:>8} {:>8.1} {:>8.1}  {}",
                     r.ring,
-                    r.target_mm,
+                    mm(r.target_mm),
                     r.reached_mm,
                     r.error_mm(),
+                    mm(r.target_height_mm),
+                    r.reached_height_mm,
+                    r.height_error_mm(),
                     shape.status(r)
                 );
             }

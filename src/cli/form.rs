@@ -5,7 +5,7 @@
 use super::Failure;
 use super::link::FormArg;
 use dressform::form::form_fit::ring_girth;
-use form_description::{FormDescription, REFERENCE_TOML};
+use form_description::FormDescription;
 use std::collections::BTreeMap;
 
 #[derive(Debug, clap::Args)]
@@ -33,13 +33,8 @@ pub fn run(args: &FormArgs) -> Result<(), Failure> {
     let FormAction::Show(show) = &args.action;
     let form = show.form.load()?;
     if show.toml {
-        let text = match show.form.path() {
-            // Loading checked that it reads and validates.
-            Some(path) => std::fs::read_to_string(path)
-                .map_err(|e| Failure::bad_input(format!("{}: cannot read: {e}", path.display())))?,
-            None => REFERENCE_TOML.to_string(),
-        };
-        out!("{text}");
+        // Loading checked that it reads and validates.
+        out!("{}", show.form.toml_text()?);
     } else {
         out!("{}", summary(&form));
     }
@@ -52,21 +47,22 @@ fn summary(form: &FormDescription) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "form \"{}\": {} nodes, {} rings, {} actuators",
+        "form \"{}\": {} nodes, {} rings, {} actuators, {} lifts",
         form.name,
         form.nodes.len(),
         form.rings.len(),
-        form.actuators.len()
+        form.actuators.len(),
+        form.lifts.len()
     );
     for node in &form.nodes {
-        let count = form.actuators.iter().filter(|a| a.node == node.address).count();
+        let count = form.axes().filter(|a| a.node == node.address).count();
         let label = node.label.as_deref().unwrap_or("-");
         let _ = writeln!(s, "  node {:>2}  {label:<20} {count} actuators", node.address);
     }
     let _ = writeln!(
         s,
-        "  {:<12} {:>9} {:>16} {:>22}",
-        "ring", "height", "centre (x, y)", "girth range (mm)"
+        "  {:<12} {:>9} {:>16} {:>22} {:>16}",
+        "ring", "height", "centre (x, y)", "girth range (mm)", "height range"
     );
     for ring in &form.rings {
         let at = |stroke: bool| -> BTreeMap<String, f64> {
@@ -77,7 +73,14 @@ fn summary(form: &FormDescription) -> String {
             (ring_girth(form, ring, &at(false)), ring_girth(form, ring, &at(true)));
         let centre = format!("({:.0}, {:.0})", ring.center_mm[0], ring.center_mm[1]);
         let range = format!("{small:.0} .. {large:.0}");
-        let _ = writeln!(s, "  {:<12} {:>9.0} {centre:>16} {range:>22}", ring.name, ring.height_mm);
+        let raised: BTreeMap<String, f64> =
+            form.lifts_of(&ring.name).map(|l| (l.id.clone(), l.stroke_mm)).collect();
+        let heights = format!("{:.0} .. {:.0}", ring.height_mm, form.ring_height(ring, &raised));
+        let _ = writeln!(
+            s,
+            "  {:<12} {:>9.0} {centre:>16} {range:>22} {heights:>16}",
+            ring.name, ring.height_mm
+        );
     }
     let _ = writeln!(
         s,
@@ -98,6 +101,26 @@ fn summary(form: &FormDescription) -> String {
             a.stroke_mm,
             a.max_speed_mm_s,
             a.max_accel_mm_s2
+        );
+    }
+    if !form.lifts.is_empty() {
+        let _ = writeln!(
+            s,
+            "  {:<16} {:>4} {:>3} {:>7} {:>7} {:>8}  raises",
+            "lift", "node", "ch", "stroke", "mm/s", "mm/s²"
+        );
+    }
+    for l in &form.lifts {
+        let _ = writeln!(
+            s,
+            "  {:<16} {:>4} {:>3} {:>7.1} {:>7.1} {:>8.1}  {}",
+            l.id,
+            l.node,
+            l.channel,
+            l.stroke_mm,
+            l.max_speed_mm_s,
+            l.max_accel_mm_s2,
+            l.rings.join(", ")
         );
     }
     s

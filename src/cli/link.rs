@@ -45,24 +45,45 @@ impl LinkArgs {
 /// `--form`, shared by every command that needs a form.
 #[derive(Debug, Clone, clap::Args)]
 pub struct FormArg {
-    /// The form description (TOML) [default: the built-in reference form; see
+    /// The form description: a TOML file, or a built-in form's name (`reference`, `male`)
+    /// where no such file exists [default: the built-in reference form; see
     /// `dressform form show --toml`].
     #[arg(long, value_name = "FORM.toml")]
     form: Option<PathBuf>,
 }
 
 impl FormArg {
-    /// Loads `--form`, or the built-in reference form.
+    /// Loads `--form` (a file, else a built-in form of that name), or the reference form.
     pub fn load(&self) -> Result<FormDescription, Failure> {
         match &self.form {
+            Some(path) if !path.exists() => {
+                path.to_str().and_then(form_description::builtin).ok_or_else(|| {
+                    let names: Vec<&str> =
+                        form_description::BUILTIN.iter().map(|(n, _)| *n).collect();
+                    Failure::bad_input(format!(
+                        "--form {}: no such file, and not a built-in form ({})",
+                        path.display(),
+                        names.join(", ")
+                    ))
+                })
+            }
             Some(path) => FormDescription::load(path).map_err(Failure::bad_input),
             None => Ok(form_description::reference()),
         }
     }
 
-    /// The file given, if any.
-    pub fn path(&self) -> Option<&PathBuf> {
-        self.form.as_ref()
+    /// The description's TOML text: the file's, or the built-in form's with its comments.
+    pub fn toml_text(&self) -> Result<String, Failure> {
+        match &self.form {
+            Some(path) if path.exists() => std::fs::read_to_string(path)
+                .map_err(|e| Failure::bad_input(format!("{}: cannot read: {e}", path.display()))),
+            Some(path) => Ok(path
+                .to_str()
+                .and_then(form_description::builtin_toml)
+                .unwrap_or_default()
+                .into()),
+            None => Ok(form_description::REFERENCE_TOML.into()),
+        }
     }
 }
 

@@ -13,7 +13,7 @@ use super::{Failure, FrameArgs, LegArgs, SmoothArgs, print_warnings, progress_ba
 use dressform::atomic_output::OutputSet;
 use dressform::body::scan::{self, Scan, ScanOptions, format::Export, format::Format};
 use dressform::form::controller::{DriveOptions, LinkSpec};
-use dressform::form::form_fit::{ShapeOutcome, compare};
+use dressform::form::form_fit::{ShapeOutcome, Targets, Tolerance, compare};
 use dressform::pose::body_model::BodyModel;
 use dressform::pose::model_fit::verdict::RegionResidual;
 use dressform::run::outputs::Outputs;
@@ -54,10 +54,9 @@ pub struct RunArgs {
 
 pub fn run(args: &RunArgs) -> Result<(), Failure> {
     let form = args.form.load()?;
-    let girth_tolerance = args.shape.girth_tolerance()?;
+    let tolerance = args.shape.tolerance()?;
     let link = args.link.spec();
-    let drive =
-        Drive { link: &link, sim: &args.sim, options: &args.shape.options(), girth_tolerance };
+    let drive = Drive { link: &link, sim: &args.sim, options: &args.shape.options(), tolerance };
     // Read and checked once the form is claimed (see `shape_form`): nothing here moves it.
     let scan_path = args.scan.clone();
     let scan_options = ScanOptions { frame: args.frame.options(), smooth: args.smooth.smooth };
@@ -85,8 +84,8 @@ pub struct Drive<'a> {
     pub sim: &'a SimArgs,
     /// The drive's options.
     pub options: &'a DriveOptions,
-    /// A ring off the mannequin's girth by more than this is not reached, mm.
-    pub girth_tolerance: f64,
+    /// How far a ring may be off the mannequin's girth and its body level.
+    pub tolerance: Tolerance,
 }
 
 /// How `run` and `demo` make the pose-symmetric scan.
@@ -149,8 +148,11 @@ pub fn shape_form<X: Send + 'static>(
         errln!("warning: {warning}");
     }
     let setpoints = &done.shaped.setpoints;
-    let shape =
-        compare(form, &report.positions_mm, &setpoints.target_girths_mm, drive.girth_tolerance);
+    let targets = Targets {
+        girths_mm: &setpoints.target_girths_mm,
+        heights_mm: &setpoints.target_heights_mm,
+    };
+    let shape = compare(form, &report.positions_mm, targets, drive.tolerance);
     outln!(
         "{} on {}: {} actuators moved together in {} ms; {}.",
         report.form,
@@ -160,7 +162,7 @@ pub fn shape_form<X: Send + 'static>(
         if shape.summary().is_some() {
             "every actuator reached its set-point, but the form could NOT take the shape"
         } else {
-            "every actuator reached its set-point and every ring the mannequin's girth"
+            "every actuator reached its set-point and every ring the mannequin's girth and level"
         }
     );
     outln!();
@@ -187,7 +189,7 @@ fn reconstruct_and_write(
     let (shaped, export) = (&done.shaped, Export::canonical(Format::Obj));
     let files =
         Outputs::reposed(&shaped.symmetrized, &done.reposed, &done.as_scanned, scan, &export)
-            .with_setpoints(&shaped.setpoints);
+            .with_form(form, &shaped.fit, &shaped.setpoints);
     outputs.append(files.files().map_err(Failure::other)?);
     outputs.commit(out).map_err(Failure::other)?;
     bar.finish_and_clear();

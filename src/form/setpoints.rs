@@ -5,7 +5,8 @@
 //!   "format": "dressform-setpoints/1",
 //!   "form": "reference",
 //!   "positions_mm": { "chest-l1": 23.5, "chest-front": 12.0 },
-//!   "target_girths_mm": { "chest": 961.8, "waist": 801.2 }
+//!   "target_girths_mm": { "chest": 961.8, "waist": 801.2 },
+//!   "target_heights_mm": { "chest": 1224.0, "waist": 1050.0 }
 //! }
 //! ```
 //!
@@ -15,11 +16,15 @@
 //!   (fully retracted) end. Actuators the file leaves out stay where they are;
 //! * `target_girths_mm` (optional; `setpoints` and `run` write it) maps a ring of that form
 //!   to the mannequin's tape girth the ring should take: after the move `drive` compares
-//!   each ring's reached girth with it (`form_fit::outcome`).
+//!   each ring's reached girth with it (`form_fit::outcome`);
+//! * `target_heights_mm` (optional, likewise) maps a ring to the body level it stands for
+//!   (mm above the floor): after the move `drive` compares the height the form's lifts
+//!   reached with it. A lift is an actuator like any other in `positions_mm`.
 //!
 //! Loading refuses an id given twice (JSON parsers would keep the last silently), an unknown
 //! actuator or ring, a non-finite value, a girth that is not positive or beyond
-//! [`MAX_GIRTH_MM`], or another form's name, naming the file and the field or actuator.
+//! [`MAX_GIRTH_MM`], a height outside 0..=[`MAX_COORDINATE_MM`], or another form's
+//! name, naming the file and the field or actuator.
 //! [`SetPoints::check`] then refuses positions outside `[0, stroke]` with the list of
 //! offenders, or clamps them into the stroke and reports them (`--clamp`); only a [`Checked`]
 //! set of targets can be driven.
@@ -35,7 +40,7 @@ use crate::atomic_output::{WriteError, write_atomically};
 use crate::form::safety::SafeTarget;
 use crate::input::{self, InputError};
 use crate::messages;
-use crate::shape::profiles::MAX_GIRTH_MM;
+use crate::shape::profiles::{MAX_COORDINATE_MM, MAX_GIRTH_MM};
 
 /// The `format` of the files this module reads and writes.
 pub const FORMAT: &str = "dressform-setpoints/1";
@@ -54,6 +59,9 @@ pub struct SetPoints {
     /// Ring → the mannequin's tape girth it should take, mm (empty: not recorded).
     #[serde(default, deserialize_with = "unique_keys", skip_serializing_if = "BTreeMap::is_empty")]
     pub target_girths_mm: BTreeMap<String, f64>,
+    /// Ring → the body level it should stand at, mm above the floor (empty: not recorded).
+    #[serde(default, deserialize_with = "unique_keys", skip_serializing_if = "BTreeMap::is_empty")]
+    pub target_heights_mm: BTreeMap<String, f64>,
 }
 
 /// A JSON object into a map, refusing a key given twice (by name).
@@ -118,12 +126,19 @@ impl SetPoints {
             form: form.into(),
             positions_mm,
             target_girths_mm: BTreeMap::new(),
+            target_heights_mm: BTreeMap::new(),
         }
     }
 
     /// The same, with the mannequin's girth each ring should take (ring → mm).
     pub fn with_target_girths(mut self, target_girths_mm: BTreeMap<String, f64>) -> Self {
         self.target_girths_mm = target_girths_mm;
+        self
+    }
+
+    /// These set-points with the rings' target heights (ring → mm above the floor).
+    pub fn with_target_heights(mut self, target_heights_mm: BTreeMap<String, f64>) -> Self {
+        self.target_heights_mm = target_heights_mm;
         self
     }
 
@@ -147,8 +162,8 @@ impl SetPoints {
     }
 
     /// Every problem with using these set-points on `form`: another form's name, unknown
-    /// actuator ids or rings, non-finite values, girths that are not positive or larger than
-    /// [`MAX_GIRTH_MM`].
+    /// actuator (or lift) ids or rings, non-finite values, girths that are not positive or
+    /// larger than [`MAX_GIRTH_MM`], heights outside 0..=[`MAX_COORDINATE_MM`].
     pub fn validate(&self, form: &FormDescription) -> Result<(), Vec<String>> {
         let mut problems = Vec::new();
         if self.form != form.name {
@@ -158,7 +173,7 @@ impl SetPoints {
             ));
         }
         for (id, &mm) in &self.positions_mm {
-            if form.actuator(id).is_none() {
+            if form.axis(id).is_none() {
                 problems.push(format!("positions_mm.{}: the form has no actuator", shown(id)));
             } else if !mm.is_finite() {
                 problems.push(format!(
@@ -176,6 +191,17 @@ impl SetPoints {
                 let (mm, max) = (messages::number(mm), messages::number(MAX_GIRTH_MM));
                 problems.push(format!(
                     "target_girths_mm.{name}: {mm} is not a girth in mm (above 0, at most {max})"
+                ));
+            }
+        }
+        for (ring, &mm) in &self.target_heights_mm {
+            let name = shown(ring);
+            if !form.rings.iter().any(|r| &r.name == ring) {
+                problems.push(format!("target_heights_mm.{name}: the form has no ring \"{name}\""));
+            } else if !(0.0..=MAX_COORDINATE_MM).contains(&mm) {
+                let (mm, max) = (messages::number(mm), messages::number(MAX_COORDINATE_MM));
+                problems.push(format!(
+                    "target_heights_mm.{name}: {mm} is not a height in mm above the floor (0 to {max})"
                 ));
             }
         }
@@ -201,7 +227,7 @@ impl SetPoints {
         let mut checked = Checked { targets: BTreeMap::new(), clamped: Vec::new() };
         let mut offending = Vec::new();
         for (id, &asked) in &self.positions_mm {
-            let Some(spec) = form.actuator(id) else {
+            let Some(spec) = form.axis(id) else {
                 offending.push((id.clone(), asked, f64::NAN));
                 continue;
             };

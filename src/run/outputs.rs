@@ -7,6 +7,7 @@
 //! | [`PROFILES`] | its sections ([`crate::shape::profiles`]), what a form is fitted to |
 //! | [`MEASUREMENTS`] | Table 1 and Fig. 11 ([`crate::shape::measure::Comparison`]); after pose symmetry, with the scan's column ([`crate::run::reconstruct::MeasurementsReport`]) |
 //! | [`SETPOINTS`] | with a form: the set-points ([`crate::form::setpoints`]) |
+//! | [`FORM_FIT`] | with a form: its rings over the mannequin and each ring from above |
 //! | [`PREVIEW`] | the scan (and the pose-symmetric scan) and the mannequin in three views |
 //! | [`SECTIONS`] | the chest, waist and hip sections of both (paper Fig. 9 and 11) |
 //! | `posed.<ext>` | after pose symmetry: the pose-symmetric scan, as the [`Export`] says |
@@ -16,10 +17,12 @@
 use crate::atomic_output::OutputSet;
 use crate::body::scan::Scan;
 use crate::body::scan::format::Export;
+use crate::form::form_fit::FormFit;
 use crate::form::setpoints::SetPoints;
 use crate::run::pipeline::Symmetrized;
-use crate::run::preview::{preview_png, sections_svg};
+use crate::run::preview::{form_fit_png, preview_png, sections_svg};
 use crate::run::reconstruct::{AsScanned, MeasurementsReport, Reposed};
+use form_description::FormDescription;
 
 /// The mannequin's file name without its extension (the export adds it).
 pub const MANNEQUIN: &str = "mannequin";
@@ -29,6 +32,8 @@ pub const PROFILES: &str = "profiles.json";
 pub const MEASUREMENTS: &str = "measurements.json";
 /// The form's set-points.
 pub const SETPOINTS: &str = "setpoints.json";
+/// The picture of the form's fit.
+pub const FORM_FIT: &str = "form-fit.png";
 /// The picture of the scan and the mannequin.
 pub const PREVIEW: &str = "preview.png";
 /// The picture of the sections.
@@ -48,7 +53,8 @@ pub struct Outputs<'a> {
     /// The body the mannequin was made from.
     scan: &'a Scan,
     export: &'a Export,
-    setpoints: Option<&'a SetPoints>,
+    /// With a form: the form, its fit and set-points.
+    form: Option<(&'a FormDescription, &'a FormFit, &'a SetPoints)>,
     /// The input scan, how it was re-posed and what it measured as it stood, after pose
     /// symmetry.
     reposed: Option<(&'a Scan, &'a Reposed, &'a AsScanned)>,
@@ -57,7 +63,7 @@ pub struct Outputs<'a> {
 impl<'a> Outputs<'a> {
     /// The files of `result`, the mannequin of `scan`, its own file written as `export` says.
     pub fn of(result: &'a Symmetrized, scan: &'a Scan, export: &'a Export) -> Self {
-        Outputs { result, scan, export, setpoints: None, reposed: None }
+        Outputs { result, scan, export, form: None, reposed: None }
     }
 
     /// The files of `result`, the mannequin of the pose-symmetric scan of `reposed`, made from
@@ -74,9 +80,14 @@ impl<'a> Outputs<'a> {
         Outputs { reposed: Some((input, reposed, as_scanned)), ..of }
     }
 
-    /// With the set-points of a form fitted to the mannequin.
-    pub fn with_setpoints(self, setpoints: &'a SetPoints) -> Self {
-        Outputs { setpoints: Some(setpoints), ..self }
+    /// With a form fitted to the mannequin: its fit and set-points.
+    pub fn with_form(
+        self,
+        form: &'a FormDescription,
+        fit: &'a FormFit,
+        setpoints: &'a SetPoints,
+    ) -> Self {
+        Outputs { form: Some((form, fit, setpoints)), ..self }
     }
 
     /// The set of files (see the module documentation).
@@ -85,8 +96,9 @@ impl<'a> Outputs<'a> {
         let mut set = OutputSet::new();
         set.add(self.export.file_name(MANNEQUIN), result.mannequin_file(self.export, &scan.frame));
         set.add(PROFILES, serde_json::to_vec_pretty(&result.profiles)?);
-        if let Some(setpoints) = self.setpoints {
+        if let Some((form, fit, setpoints)) = self.form {
             set.add(SETPOINTS, setpoints.to_json_string());
+            set.add(FORM_FIT, form_fit_png(result, fit, form));
         }
         set.add(SECTIONS, sections_svg(&scan.body, result));
         match self.reposed {

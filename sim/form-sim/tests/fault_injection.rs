@@ -147,7 +147,7 @@ async fn faults_can_be_injected_while_the_form_runs() {
     assert!(form.inject("hip-r2", ActuatorFault::Encoder));
     assert!(!form.inject("hip-r9", ActuatorFault::Stall));
     assert!(form.reboot(node(1)));
-    assert!(!form.reboot(node(9)));
+    assert!(!form.reboot(node(10)));
     host.run_for(Duration::from_millis(10)).await;
     let truth = form.state();
     assert_eq!(truth.node(node(6)).unwrap().faults, Faults::FOLLOWING_ERROR);

@@ -34,13 +34,12 @@ async fn homed_form(kind: CanKind) -> (CanBus, SimulatedForm, TestHost, FormDesc
     (bus, form, host, description)
 }
 
-/// A target for every actuator, spread over 5..95 % of its stroke, in mm.
+/// A target for every actuator, the lifts' too, spread over 5..95 % of its stroke, in mm.
 fn targets(description: &FormDescription) -> HashMap<String, f64> {
     description
-        .actuators
-        .iter()
+        .axes()
         .enumerate()
-        .map(|(i, a)| (a.id.clone(), a.stroke_mm * (0.05 + 0.9 * ((i * 7) % 11) as f64 / 10.0)))
+        .map(|(i, a)| (a.id.to_string(), a.stroke_mm * (0.05 + 0.9 * ((i * 7) % 11) as f64 / 10.0)))
         .collect()
 }
 
@@ -58,8 +57,8 @@ fn full_update(
         .map(|n| {
             let mut node_targets = NodeTargets { node: n, targets: [None; 8] };
             for a in description.actuators_of(n) {
-                let target = Position::from_mm(targets[&a.id] as f32).unwrap();
-                let from = Position::from_mm(positions[&a.id] as f32).unwrap();
+                let target = Position::from_mm(targets[a.id] as f32).unwrap();
+                let from = Position::from_mm(positions[a.id] as f32).unwrap();
                 let distance = target.hundredths_mm().abs_diff(from.hundredths_mm());
                 let ms = update::shortest_duration_ms(distance, a.max_speed(), a.max_accel());
                 duration_ms = duration_ms.max(ms.unwrap());
@@ -111,10 +110,9 @@ fn arrivals(
                 continue;
             };
             let still = moving.get(&n).is_some_and(|m| m & (1 << index) == 0);
-            let on_target =
-                slot.is_some_and(|p| (p.mm() - targets[&spec.id]).abs() <= TOLERANCE_MM);
+            let on_target = slot.is_some_and(|p| (p.mm() - targets[spec.id]).abs() <= TOLERANCE_MM);
             if still && on_target {
-                arrived.entry(spec.id.clone()).or_insert(*at);
+                arrived.entry(spec.id.to_string()).or_insert(*at);
             }
         }
     }
@@ -128,16 +126,15 @@ async fn a_synchronised_move_of_all_actuators_arrives_together_on_target() {
     let targets = targets(&description);
     let (packets, duration_ms) =
         full_update(&description, &targets, &positions(&form), Link::ClassicCan);
-    assert_eq!(packets.len(), 17);
+    assert_eq!(packets.len(), 19);
     assert!(duration_ms > 2000, "a full move takes seconds ({duration_ms} ms)");
 
     let start = Instant::now();
     host.queue(packets);
     // Sample the truth every millisecond: nobody exceeds its limits.
     let limits: HashMap<String, (f64, f64)> = description
-        .actuators
-        .iter()
-        .map(|a| (a.id.clone(), (a.max_speed_mm_s, a.max_accel_mm_s2)))
+        .axes()
+        .map(|a| (a.id.to_string(), (a.max_speed_mm_s, a.max_accel_mm_s2)))
         .collect();
     let mut previous = form.state();
     let end = start + Duration::from_millis(u64::from(duration_ms) + 300);
@@ -156,7 +153,11 @@ async fn a_synchronised_move_of_all_actuators_arrives_together_on_target() {
     }
 
     let arrived = arrivals(&host.received, &description, &targets);
-    assert_eq!(arrived.len(), 64, "not every actuator arrived: {arrived:?}");
+    assert_eq!(
+        arrived.len(),
+        description.axes().count(),
+        "not every actuator arrived: {arrived:?}"
+    );
     let first = arrived.values().min().unwrap();
     let last = arrived.values().max().unwrap();
     let spread = *last - *first;
@@ -175,12 +176,12 @@ async fn a_synchronised_move_of_all_actuators_arrives_together_on_target() {
 }
 
 #[tokio::test(start_paused = true)]
-async fn the_same_move_on_can_fd_takes_nine_frames_and_arrives_on_target() {
+async fn the_same_move_on_can_fd_takes_ten_frames_and_arrives_on_target() {
     let (_bus, form, mut host, description) = homed_form(CanKind::FD_1M_5M).await;
     let targets = targets(&description);
     let (packets, duration_ms) =
         full_update(&description, &targets, &positions(&form), Link::CanFd);
-    assert_eq!(packets.len(), 9);
+    assert_eq!(packets.len(), 10);
     host.queue(packets);
     host.run_for(Duration::from_millis(u64::from(duration_ms) + 100)).await;
     for actuator in form.state().actuators {
@@ -260,11 +261,8 @@ async fn the_watchdog_stops_motion_within_300_ms_and_one_tick_of_the_last_heartb
         "tripped {after:?} after the last heartbeat"
     );
     // Stopping at the acceleration limit takes at most max speed / max acceleration.
-    let stop_by = description
-        .actuators
-        .iter()
-        .map(|a| a.max_speed_mm_s / a.max_accel_mm_s2)
-        .fold(0.0, f64::max);
+    let stop_by =
+        description.axes().map(|a| a.max_speed_mm_s / a.max_accel_mm_s2).fold(0.0, f64::max);
     assert!(stop_by < 0.4);
     let state = form.state();
     assert!(state.actuators.iter().all(|a| a.state.velocity_mm_s == 0.0 && !a.state.moving));
@@ -276,7 +274,7 @@ async fn the_watchdog_stops_motion_within_300_ms_and_one_tick_of_the_last_heartb
             matches!(p.message, Message::Emergency(e) if e.code == EmergencyCode::HOST_TIMEOUT)
         })
         .count();
-    assert_eq!(timeouts, 8);
+    assert_eq!(timeouts, description.nodes.len());
 }
 
 #[tokio::test(start_paused = true)]
@@ -305,7 +303,7 @@ async fn an_emergency_stop_halts_every_actuator() {
             matches!(p.message, Message::Emergency(e) if e.code == EmergencyCode::EMERGENCY_STOP)
         })
         .count();
-    assert_eq!(events, 8);
+    assert_eq!(events, description.nodes.len());
 
     // Nothing moves any more, whatever the host sends.
     let (again, _) = full_update(&description, &targets, &positions(&form), Link::ClassicCan);
@@ -366,7 +364,7 @@ async fn a_sync_during_a_move_retargets_from_the_current_position_and_velocity()
         let state = form.state();
         let dt = (state.at - previous.at).as_secs_f64();
         for (a, b) in state.actuators.iter().zip(&previous.actuators) {
-            let limit = description.actuator(&a.id).unwrap().max_accel_mm_s2;
+            let limit = description.axis(&a.id).unwrap().max_accel_mm_s2;
             let accel = (a.state.velocity_mm_s - b.state.velocity_mm_s) / dt;
             assert!(accel.abs() <= limit + 1e-6, "{} jerked: {accel}", a.id);
         }

@@ -49,7 +49,10 @@ fn python_can_identifies_every_node_over_slcan_and_reads_the_log() {
 
     let identified = peer(&["identify", &device, &nodes]);
     let summary = String::from_utf8_lossy(&identified.stdout);
-    assert!(summary.starts_with("identified nodes=8 strokes=[2500, 6000"), "{summary}");
+    assert!(
+        summary.starts_with(&format!("identified nodes={nodes} strokes=[2500, 6000")),
+        "{summary}"
+    );
 
     server.shutdown().unwrap();
     let lines = std::fs::read_to_string(&log).unwrap().lines().count();

@@ -308,11 +308,10 @@ fn cleared_notes(cleared: &[Cleared]) -> Vec<String> {
 fn positions_of<T: Transport>(session: &Session<T>) -> BTreeMap<String, f64> {
     session
         .form()
-        .actuators
-        .iter()
+        .axes()
         .filter_map(|a| {
             let p = session.nodes().get(&a.node_id()?)?.positions[a.actuator()?.index()]?;
-            Some((a.id.clone(), p.mm()))
+            Some((a.id.to_string(), p.mm()))
         })
         .collect()
 }

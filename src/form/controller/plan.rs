@@ -22,7 +22,7 @@ pub fn plan(
         .targets
         .iter()
         .filter_map(|(id, &target)| {
-            let spec = form.actuator(id)?;
+            let spec = form.axis(id)?;
             Some(PlannedTarget {
                 id: id.clone(),
                 node: spec.node_id()?,

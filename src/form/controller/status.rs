@@ -75,7 +75,7 @@ pub async fn status<T: Transport>(
                     .iter()
                     .map(|a| {
                         let p = a.actuator().and_then(|i| status.positions[i.index()]);
-                        (a.id.clone(), p.map(|p| p.mm()))
+                        (a.id.to_string(), p.map(|p| p.mm()))
                     })
                     .collect(),
                 problems: problems.iter().map(ToString::to_string).collect(),

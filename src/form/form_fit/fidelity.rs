@@ -112,6 +112,7 @@ mod tests {
             form_height_mm: 1080.0,
             mannequin_height_mm: 1060.0,
             offset_mm: 20.0,
+            lifted: false,
             mannequin_girth_mm: mannequin,
             form_girth_mm: form,
             rms_radial_gap_mm: 0.0,

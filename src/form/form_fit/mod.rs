@@ -1,20 +1,26 @@
-//! Fitting the robotic form to a mannequin: where each of the form's rings meets the mannequin
-//! ([`placement`]), and the actuator extensions that make each ring take the mannequin's
-//! section ([`rings`]: its girth exactly, its shape by least squares, [`least_squares`]), with a
-//! fidelity report ([`RingStatus`], [`GirthReach`], the radial gaps in [`RingFit`]).
+//! Fitting the robotic form to a mannequin: the body level each of the form's rings stands for
+//! ([`placement`]), the lifts that bring the rings there ([`heights`], heights first), and the
+//! actuator extensions that make each ring take the mannequin's section ([`rings`]: its girth
+//! exactly, its shape by least squares, [`least_squares`]), with a fidelity report
+//! ([`RingStatus`], [`GirthReach`], the height error and the radial gaps in [`RingFit`]).
 //!
-//! **Placement rule.** A ring whose description states an `anchor` (`neck`, `chest`, `waist`,
-//! `hip`) is set to the mannequin's neck landmark or its chest, waist or hip level; a ring
-//! shapes the torso or the leg its `part` names. Every other ring keeps its place
-//! between its neighbours: its height maps piecewise-linearly through the anchors (below the
-//! lowest anchor and above the highest, with the nearest segment's scale). The reference form
-//! has no height adjustment, so each ring stays where it is built; the report says how far it
-//! sits from the mannequin level it shapes (`offset_mm`).
+//! **Placement rule.** A ring whose description states an `anchor` is set to that body level
+//! on the mannequin ([`level`]: the neck landmark; the shoulders two thirds of the way from the
+//! armpits to the neck; the chest, waist and hip levels; the fold under the bust; the abdomen
+//! midway between waist and hip; the thighs just under the crotch, where the thigh girth is
+//! measured); a ring shapes the torso or the leg its `part` names. Every other ring keeps its
+//! place between its neighbours: its built height maps piecewise-linearly through the anchored
+//! rings'. The lifts then set the rings' heights as close to their levels as the strokes allow
+//! (one bounded least-squares problem over all rings); each ring takes the girth of its level's
+//! section, and its radial gaps are measured to the mannequin where it stands. The report says
+//! how far each ring stands from its level (`offset_mm`, the height error): 0 where the lifts
+//! reach, its built height's distance on a form without lifts.
 //!
 //! **Frame.** The mannequin's symmetry plane is put on the form's (x = 0); both use the
 //! canonical frame otherwise (+X = the subject's left, front = -Y).
 
 mod fidelity;
+pub mod heights;
 mod least_squares;
 pub mod outcome;
 mod placement;
@@ -22,9 +28,14 @@ mod rings;
 
 pub use fidelity::{GirthReach, RingStatus};
 pub use least_squares::GAP_RAYS;
-pub use outcome::{DEFAULT_GIRTH_TOLERANCE_MM, ShapeOutcome, compare};
-pub use placement::HeightMap;
-pub use rings::{Placement, RingFit, SHAPE_NOTE_MM, Saturation, region_of, ring_girth};
+pub use outcome::{
+    DEFAULT_GIRTH_TOLERANCE_MM, DEFAULT_HEIGHT_TOLERANCE_MM, ShapeOutcome, Targets, Tolerance,
+    compare,
+};
+pub use placement::{RingLevels, SHOULDERS_ABOVE_ARMPITS, UNDER_BUST_BELOW_CHEST, level};
+pub use rings::{
+    Placement, RingFit, SHAPE_NOTE_MM, Saturation, region_of, ring_girth, ring_skin, section_at,
+};
 
 use crate::body::regions::Region;
 use crate::form::setpoints::SetPoints;
@@ -40,8 +51,11 @@ pub struct FormFit {
     pub form: String,
     /// Per ring: where it shapes the mannequin and how well.
     pub rings: Vec<RingFit>,
-    /// Extension of every actuator of the form (mm from its retracted end), within its stroke.
+    /// Extension of every actuator and lift of the form (mm from its retracted end), within
+    /// its stroke.
     pub positions_mm: BTreeMap<String, f64>,
+    /// Each lift's extension (mm), also in `positions_mm`: how far it raises its rings.
+    pub lifts_mm: BTreeMap<String, f64>,
 }
 
 impl FormFit {
@@ -61,11 +75,21 @@ impl FormFit {
             .collect()
     }
 
-    /// The set-point file of the fit, with each ring's target girth
-    /// ([`Self::target_girths`]), so that a drive can tell whether the form took the shape.
+    /// The body level of every ring a lift carries (ring → mm above the floor): where its
+    /// lifts should bring it ([`outcome`]). A ring without a lift stands where it is built
+    /// and is not judged by its height.
+    pub fn target_heights(&self) -> BTreeMap<String, f64> {
+        let lifted = self.rings.iter().filter(|r| r.lifted);
+        lifted.map(|r| (r.ring.clone(), r.mannequin_height_mm)).collect()
+    }
+
+    /// The set-point file of the fit, with each ring's target girth and height
+    /// ([`Self::target_girths`], [`Self::target_heights`]), so that a drive can tell whether
+    /// the form took the shape.
     pub fn setpoints(&self) -> SetPoints {
         SetPoints::new(self.form.clone(), self.positions_mm.clone())
             .with_target_girths(self.target_girths())
+            .with_target_heights(self.target_heights())
     }
 }
 
@@ -169,16 +193,21 @@ pub fn fit_by(
     rule: Placement,
 ) -> Result<FormFit, FormFitError> {
     profiles.validate(&regions_of(form)).map_err(FormFitError::Invalid)?;
-    let placement = HeightMap::new(profiles, form);
-    let mut positions_mm = BTreeMap::new();
+    let levels = RingLevels::new(profiles, form);
+    // Heights first: the lifts bring the rings to their levels; then each ring's panels.
+    let heights = heights::solve(form, &levels);
+    let lifts_mm = heights.lifts_mm;
+    let mut positions_mm = lifts_mm.clone();
     let mut fits = Vec::with_capacity(form.rings.len());
     for ring in &form.rings {
-        let (fit, extensions) = rings::fit_ring(profiles, form, ring, &placement, rule)?;
+        let placed = (levels.of(&ring.name), heights.rings_mm[&ring.name]);
+        let (fit, extensions) = rings::fit_ring(profiles, form, ring, placed, rule)?;
         positions_mm.extend(extensions);
         fits.push(fit);
     }
     // Mirror pairs: the mean of the two (on a symmetric mannequin they differ only by rounding
-    // and, across two rings such as the thighs, by the least squares' tolerance, 1e-4 mm).
+    // and, across two rings such as the thighs, by the least squares' tolerance, 1e-4 mm);
+    // mirror lifts share their variable already.
     for a in &form.actuators {
         if let Some(b) = form.mirror_of(&a.id).filter(|b| b.id != a.id) {
             let mean = 0.5 * (positions_mm[&a.id] + positions_mm[&b.id]);
@@ -186,5 +215,5 @@ pub fn fit_by(
             positions_mm.insert(b.id.clone(), mean);
         }
     }
-    Ok(FormFit { form: form.name.clone(), rings: fits, positions_mm })
+    Ok(FormFit { form: form.name.clone(), rings: fits, positions_mm, lifts_mm })
 }

@@ -11,7 +11,6 @@
 //! ([`Placement::LeastSquares`], [`super::least_squares`]). Extensions stay within the
 //! stroke; an actuator whose target lies beyond it is reported with the excess.
 
-use super::HeightMap;
 use super::least_squares::{self, gap_directions, rms};
 use crate::body::regions::Region;
 use crate::body::slice::{Contour, convex_hull};
@@ -56,18 +55,24 @@ pub struct RingFit {
     pub ring: String,
     /// The mannequin level it is anchored to, if any.
     pub anchor: Option<Anchor>,
-    /// Where the ring is built on the form (mm).
+    /// Where the ring stands on the form, its lifts set (mm above the floor).
     pub form_height_mm: f64,
-    /// The mannequin height it shapes (mm).
+    /// The body level it stands for, where it shapes the mannequin (mm).
     pub mannequin_height_mm: f64,
-    /// `form_height_mm - mannequin_height_mm`: how far the ring sits from its level.
+    /// `form_height_mm - mannequin_height_mm`: the height error, how far the ring sits
+    /// from its level.
     pub offset_mm: f64,
+    /// Whether a lift carries the ring: only then is its height a target a drive is judged by
+    /// (a ring without one stands where it is built, and the error is only reported).
+    pub lifted: bool,
     /// The mannequin's tape girth there (mm); 0 where the mannequin has no section.
     pub mannequin_girth_mm: f64,
     /// The form's girth at the set-points (mm).
     pub form_girth_mm: f64,
     /// The root mean square of the radial gaps between the form's skin and the mannequin's
-    /// section, over [`least_squares::GAP_RAYS`] rays from the ring's axis (mm).
+    /// section where the ring stands (its level's once the lifts reach it, or where the
+    /// mannequin has no section at its height), over
+    /// [`least_squares::GAP_RAYS`] rays from the ring's axis (mm).
     pub rms_radial_gap_mm: f64,
     /// The largest of those gaps, either way (mm). (Before issue 31 this was the largest
     /// gap at the panels' centres: that is now the largest of [`Self::panel_gaps_mm`].)
@@ -83,7 +88,7 @@ pub struct RingFit {
 
 /// The mannequin's section (relative to the form's axis) at height `z` in `region`: the blend
 /// of the two layers around it (layers of one region have the same number of points).
-fn section_at(profiles: &Profiles, region: Region, z: f64) -> Option<Contour> {
+pub fn section_at(profiles: &Profiles, region: Region, z: f64) -> Option<Contour> {
     let layers: Vec<&ProfileLayer> =
         profiles.layers.iter().filter(|l| l.region == region).collect();
     let k = layers.windows(2).position(|w| w[0].z <= z && z <= w[1].z)?;
@@ -115,11 +120,23 @@ pub fn ring_girth(
     ring: &RingSpec,
     positions_mm: &BTreeMap<String, f64>,
 ) -> f64 {
+    ring_skin(form, ring, positions_mm).perimeter()
+}
+
+/// The form's skin on `ring` with its actuators at `positions_mm` (id → mm; missing ids
+/// count as retracted): the convex hull of its panels, in the form's frame (x = 0 its
+/// symmetry plane).
+pub fn ring_skin(
+    form: &FormDescription,
+    ring: &RingSpec,
+    positions_mm: &BTreeMap<String, f64>,
+) -> Contour {
     let actuators: Vec<&ActuatorSpec> =
         form.actuators.iter().filter(|a| a.ring == ring.name).collect();
     let extensions: Vec<f64> =
         actuators.iter().map(|a| positions_mm.get(&a.id).copied().unwrap_or(0.0)).collect();
-    skin_girth(DVec2::from_array(ring.center_mm), &actuators, &extensions)
+    let points = skin_points(DVec2::from_array(ring.center_mm), &actuators, &extensions);
+    Contour { points: convex_hull(&points) }
 }
 
 /// Girth of the skin over the panels of `actuators` at `extensions`.
@@ -151,14 +168,15 @@ const BRACKET_MARGIN_MM: f64 = 1.0;
 /// millimetre a denoised mannequin's surface is known to ([`SHAPE_NOTE_MM`]).
 const GIRTH_MATCHED_MM: f64 = 0.01;
 
-/// Fits one ring; returns its report and the extensions of its actuators. Steps: place the
-/// ring on the mannequin ([`HeightMap`]), take the mannequin's section there, then match its
-/// girth and shape ([`Panels::place`]); a ring with no section stays retracted.
+/// Fits one ring standing at `height` for body level `level` (`placed`: (level, height), mm);
+/// returns its report and the extensions of its actuators. Steps: take the mannequin's section
+/// at the level, then match its girth and shape ([`Panels::place`]); a ring with no section
+/// stays retracted.
 pub(super) fn fit_ring(
     profiles: &Profiles,
     form: &FormDescription,
     ring: &RingSpec,
-    placement: &HeightMap,
+    (z, height): (f64, f64),
     rule: Placement,
 ) -> Result<(RingFit, Vec<(String, f64)>), super::FormFitError> {
     let actuators: Vec<&ActuatorSpec> =
@@ -166,13 +184,24 @@ pub(super) fn fit_ring(
     if actuators.is_empty() {
         return Err(super::FormFitError::EmptyRing(ring.name.clone()));
     }
-    let z = placement.mannequin_height(ring.height_mm);
     let centre = DVec2::from_array(ring.center_mm);
-    let mut report = RingFit::placed(ring, z);
-    let extensions = match section_at(profiles, region_of(ring), z) {
+    let mut report = RingFit::placed(ring, z, height);
+    report.lifted = form.lifts_of(&ring.name).next().is_some();
+    let region = region_of(ring);
+    let extensions = match section_at(profiles, region, z) {
         Some(section) => {
             let groups = mirror_groups(&actuators);
-            Panels::against(&section, centre, &actuators).place(rule, &groups, &mut report)
+            let extensions =
+                Panels::against(&section, centre, &actuators).place(rule, &groups, &mut report);
+            // The gaps are the skin's to the mannequin where the ring stands: off its level, to
+            // the section there (where the mannequin has none, above the neck or below the
+            // legs, the level's stand).
+            if (height - z).abs() > super::heights::TOLERANCE_MM
+                && let Some(there) = section_at(profiles, region, height)
+            {
+                Panels::against(&there, centre, &actuators).report_gaps(&extensions, &mut report);
+            }
+            extensions
         }
         // No mannequin there (above the neck, below the legs): the ring stays retracted.
         None => {
@@ -186,15 +215,16 @@ pub(super) fn fit_ring(
 }
 
 impl RingFit {
-    /// The report of `ring` placed at mannequin height `z`, before it is shaped: no girths,
-    /// no gap, nothing saturated.
-    fn placed(ring: &RingSpec, z: f64) -> Self {
+    /// The report of `ring` standing at `height` for mannequin level `z`, before it is
+    /// shaped: no girths, no gap, nothing saturated.
+    fn placed(ring: &RingSpec, z: f64, height: f64) -> Self {
         RingFit {
             ring: ring.name.clone(),
             anchor: ring.anchor,
-            form_height_mm: ring.height_mm,
+            form_height_mm: height,
             mannequin_height_mm: z,
-            offset_mm: ring.height_mm - z,
+            offset_mm: height - z,
+            lifted: false,
             mannequin_girth_mm: 0.0,
             form_girth_mm: 0.0,
             rms_radial_gap_mm: 0.0,
@@ -285,17 +315,23 @@ impl<'a> Panels<'a> {
         }
         report.mannequin_girth_mm = self.target;
         report.form_girth_mm = self.skin_girth(&extensions);
-        let gaps = self.gaps(&extensions);
-        report.rms_radial_gap_mm = rms(&gaps);
-        report.largest_radial_gap_mm = gaps.iter().fold(0.0, |m, g| m.max(g.abs()));
-        let ids = self.actuators.iter().map(|a| a.id.clone());
-        report.panel_gaps_mm = ids.zip(self.panel_gaps(&extensions)).collect();
+        self.report_gaps(&extensions, report);
         // Where the girth is matched, a target's excess is measured at the common offset (and
         // listed only while its panel rests at that end of its stroke); where it is out of
         // reach, at the shape targets themselves.
         report.saturated =
             self.saturations(&targets, if matched { delta } else { 0.0 }, &extensions);
         extensions
+    }
+
+    /// The radial gaps all round (RMS and largest) and each panel's at `extensions`, in
+    /// `report`.
+    fn report_gaps(&self, extensions: &[f64], report: &mut RingFit) {
+        let gaps = self.gaps(extensions);
+        report.rms_radial_gap_mm = rms(&gaps);
+        report.largest_radial_gap_mm = gaps.iter().fold(0.0, |m, g| m.max(g.abs()));
+        let ids = self.actuators.iter().map(|a| a.id.clone());
+        report.panel_gaps_mm = ids.zip(self.panel_gaps(extensions)).collect();
     }
 
     /// The extensions that put every panel's centre on the section.
@@ -462,7 +498,7 @@ mod tests {
             part: BodyPart::Torso,
             anchor: None,
         };
-        let mut report = RingFit::placed(&spec, 1000.0);
+        let mut report = RingFit::placed(&spec, 1000.0, spec.height_mm);
         let extensions = panels.place(rule, &mirror_groups(&actuators), &mut report);
         (extensions, report)
     }

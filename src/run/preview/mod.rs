@@ -8,11 +8,17 @@
 //!   scan's section, the sections of the left- and right-mirrored bodies and the symmetric ring
 //!   overlaid, with their girths.
 //!
-//! Both draw the canonical frame: heights on the scan and on the mannequin line up.
+//! - `form-fit.png` ([`form_fit_png`]): the robotic form's rings over the mannequin where the
+//!   lifts set them, and each ring seen from above: the mannequin's section there, the form's
+//!   skin and its panels coloured by their gap.
+//!
+//! They draw the canonical frame: heights on the scan and on the mannequin line up.
 
+mod form_fit;
 mod raster;
 mod sections;
 
+pub use form_fit::form_fit_png;
 pub use sections::sections_svg;
 
 use crate::body::mesh::Mesh;
@@ -84,14 +90,30 @@ fn vertex_normals(mesh: &Mesh) -> Vec<DVec3> {
     normals.iter().map(|n| n.normalize_or_zero()).collect()
 }
 
+/// A line drawn around a body as a tape would lie: a closed contour (canonical frame) at a
+/// height, in a colour; `None` where the body has no section.
+struct Level {
+    z: f64,
+    contour: Option<Contour>,
+    colour: Colour,
+}
+
+impl Level {
+    /// The chest, waist and hip lines of `contours` at `heights`, in [`LEVEL_COLOURS`].
+    fn measured(contours: Vec<Option<Contour>>, heights: [f64; 3]) -> Vec<Level> {
+        (contours.into_iter().zip(heights).zip(LEVEL_COLOURS))
+            .map(|((contour, z), colour)| Level { z, contour, colour })
+            .collect()
+    }
+}
+
 /// One body in one view: what to draw and where.
 struct Panel<'a> {
     mesh: &'a Mesh,
     normals: &'a [DVec3],
     colour: Colour,
-    /// The chest, waist and hip lines around this body (`None` where it has no section).
-    levels: &'a [Option<Contour>],
-    heights: [f64; 3],
+    /// The lines around this body.
+    levels: &'a [Level],
     view: &'a View,
     /// Left edge of the body's extent in the view (mm along screen right) and the panel's
     /// width (final pixels).
@@ -125,13 +147,13 @@ impl Panel<'_> {
         for tri in &self.mesh.triangles {
             canvas.triangle(tri.map(|v| screen[v as usize]), tri.map(|v| shade[v as usize]));
         }
-        for ((level, &z), colour) in self.levels.iter().zip(&self.heights).zip(LEVEL_COLOURS) {
-            let Some(contour) = level else { continue };
+        for Level { z, contour, colour } in self.levels {
+            let Some(contour) = contour else { continue };
             let n = contour.points.len();
             for k in 0..n {
                 let [a, b] = [contour.points[k], contour.points[(k + 1) % n]]
-                    .map(|p| to_screen(p.extend(z)) - DVec3::Z * LINE_LIFT_MM);
-                canvas.line(a, b, LINE_PX * ss, colour);
+                    .map(|p| to_screen(p.extend(*z)) - DVec3::Z * LINE_LIFT_MM);
+                canvas.line(a, b, LINE_PX * ss, *colour);
             }
         }
         canvas
@@ -139,7 +161,7 @@ impl Panel<'_> {
 }
 
 /// A body the preview shows: its mesh, vertex normals, colour and level lines.
-type Shown<'a> = (&'a Mesh, &'a [DVec3], Colour, &'a [Option<Contour>]);
+type Shown<'a> = (&'a Mesh, &'a [DVec3], Colour, &'a [Level]);
 
 /// Horizontal extent of `mesh` seen in `view` (mm along screen right).
 fn extent(mesh: &Mesh, view: &View) -> (f64, f64) {
@@ -155,6 +177,11 @@ fn extent(mesh: &Mesh, view: &View) -> (f64, f64) {
 /// `result` beside them, encoded as PNG.
 pub fn preview_png(bodies: &[(&Mesh, &str)], result: &Symmetrized) -> Vec<u8> {
     let (width, height, rgb) = preview_rgb(bodies, result);
+    encode_png(width, height, &rgb)
+}
+
+/// An 8-bit RGB image (`width` × `height`, row by row) as PNG.
+fn encode_png(width: usize, height: usize, rgb: &[u8]) -> Vec<u8> {
     let mut png = Vec::new();
     let encoder = image::codecs::png::PngEncoder::new_with_quality(
         &mut png,
@@ -163,7 +190,7 @@ pub fn preview_png(bodies: &[(&Mesh, &str)], result: &Symmetrized) -> Vec<u8> {
     );
     image::ImageEncoder::write_image(
         encoder,
-        &rgb,
+        rgb,
         width as u32,
         height as u32,
         image::ExtendedColorType::Rgb8,
@@ -177,9 +204,10 @@ fn preview_rgb(bodies: &[(&Mesh, &str)], result: &Symmetrized) -> (usize, usize,
     let m = &result.mannequin;
     let levels = &result.comparison.levels;
     let heights = [levels.chest, levels.waist, levels.hip];
-    let body_levels: Vec<Vec<Option<Contour>>> = (bodies.iter())
+    let body_levels: Vec<Vec<Level>> = (bodies.iter())
         .map(|(mesh, _)| {
-            SegmentedBody::with_regions(mesh, &result.regions).torso_sections(&heights)
+            let body = SegmentedBody::with_regions(mesh, &result.regions);
+            Level::measured(body.torso_sections(&heights), heights)
         })
         .collect();
     let ring_at = |z: f64| {
@@ -188,7 +216,7 @@ fn preview_rgb(bodies: &[(&Mesh, &str)], result: &Symmetrized) -> (usize, usize,
             .min_by(|a, b| (a.z - z).abs().total_cmp(&(b.z - z).abs()))
             .map(|l| Contour { points: l.points.clone() })
     };
-    let ring_levels: Vec<Option<Contour>> = heights.iter().map(|&z| ring_at(z)).collect();
+    let ring_levels = Level::measured(heights.iter().map(|&z| ring_at(z)).collect(), heights);
     let body_normals: Vec<Vec<DVec3>> =
         bodies.par_iter().map(|(mesh, _)| vertex_normals(mesh)).collect();
     let form_normals = vertex_normals(&m.mesh);
@@ -215,7 +243,7 @@ fn preview_rgb(bodies: &[(&Mesh, &str)], result: &Symmetrized) -> (usize, usize,
             let body_px = (hi - lo) * scale;
             let label_px = (name.len() * raster::GLYPH_PX) as f64;
             let width = (body_px.max(label_px) + 2.0 * PAD_PX).ceil() as usize;
-            panels.push(Panel { mesh, normals, colour, levels, heights, view, left_mm: lo, width });
+            panels.push(Panel { mesh, normals, colour, levels, view, left_mm: lo, width });
         }
     }
     let height = TOP_PX + BODY_PX.ceil() as usize + PAD_PX as usize + BOTTOM_PX;

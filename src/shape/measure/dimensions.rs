@@ -141,23 +141,42 @@ fn leg_girths(body: &SegmentedBody, zs: &[f64]) -> Vec<(f64, f64)> {
     left.iter().zip(&right).map(|(l, r)| (tape(l), tape(r))).collect()
 }
 
-/// The underbust girth and its level: the fold under the bust, the level set farthest back
-/// behind the front-most levels both above it (the bust) and below it (ribs or belly), between
-/// the chest level and [`UNDERBUST_SPAN`] of the stature below it. Merely the level set
-/// farthest back would be the chest level itself where that lies above the bust, at the
-/// armpits (the MakeHuman base body: underbust = chest). A front without a fold keeps the
-/// level set farthest back. `None` if the torso has no loops there.
+/// The underbust girth and its level: the fold under the bust ([`underbust_in`]) among the
+/// torso's levels between the chest level and [`UNDERBUST_SPAN`] of the stature below it.
+/// `None` if the torso has no loops there.
 pub fn underbust(body: &SegmentedBody, levels: &Levels) -> Option<Girth> {
-    let h = body.landmarks().height;
-    let under = heights(levels.chest - UNDERBUST_SPAN * h, levels.chest);
+    let under = heights(underbust_band(levels, body.landmarks().height).0, levels.chest);
     let profile: Vec<(f64, Contour)> = (under.iter().copied())
         .zip(body.torso_sections(&under))
         .filter_map(|(z, c)| Some((z, c?)))
         .collect();
+    let k = underbust_in(&profile)?;
+    Some(Girth::of(profile[k].0, &profile[k].1))
+}
+
+/// The heights (low, high) between which the underbust is looked for on a body of stature
+/// `height`: from [`UNDERBUST_SPAN`] of it below the chest level up to the chest level.
+pub fn underbust_band(levels: &Levels, height: f64) -> (f64, f64) {
+    (levels.chest - UNDERBUST_SPAN * height, levels.chest)
+}
+
+/// Which of `profile`'s sections (by ascending height, within [`underbust_band`]) is the
+/// underbust: the fold under the bust, the level set farthest back behind the front-most
+/// levels both above it (the bust) and below it (ribs or belly). Merely the level set
+/// farthest back would be the chest level itself where that lies above the bust, at the
+/// armpits (the MakeHuman base body: underbust = chest). A front without a fold keeps the
+/// level set farthest back. `None` for an empty profile.
+pub fn underbust_in(profile: &[(f64, Contour)]) -> Option<usize> {
     let fronts: Vec<f64> = profile.iter().map(|(_, c)| forward(c)).collect();
     let set_back = || (0..profile.len()).min_by(|&a, &b| fronts[a].total_cmp(&fronts[b]));
-    let k = deepest_fold(&fronts, MIN_FOLD_MM).map(|(k, _)| k).or_else(set_back)?;
-    Some(Girth::of(profile[k].0, &profile[k].1))
+    underbust_fold(profile).or_else(set_back)
+}
+
+/// The fold under the bust in `profile` (as [`underbust_in`]), if it has one at least
+/// `MIN_FOLD_MM` deep.
+pub fn underbust_fold(profile: &[(f64, Contour)]) -> Option<usize> {
+    let fronts: Vec<f64> = profile.iter().map(|(_, c)| forward(c)).collect();
+    deepest_fold(&fronts, MIN_FOLD_MM).map(|(k, _)| k)
 }
 
 /// The body dimensions of `body` with its measurement `levels`.

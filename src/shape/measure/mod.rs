@@ -37,6 +37,7 @@ pub use arms::{ArmMeasures, ArmSection, UPPER_ARM_OF_STATURE, WRIST_FROM_FINGERT
 pub use compare::{Comparison, MirrorRow, TableRow, compare};
 pub use dimensions::{
     Bilateral, BodyDimensions, KNEE_OF_CROTCH, THIGH_BELOW_CROTCH, dimensions, underbust,
+    underbust_band, underbust_fold, underbust_in,
 };
 pub use neck_and_shoulders::{
     MIDLINE_BAND_MM, NeckAndShoulders, PlaneMeasure, across_back_and_front, neck_and_shoulders,

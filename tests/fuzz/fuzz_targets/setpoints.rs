@@ -14,7 +14,7 @@ fuzz_target!(|bytes: &[u8]| {
     for clamp in [false, true] {
         if let Ok(checked) = points.check(&form, clamp) {
             for (id, target) in &checked.targets {
-                let stroke = form.actuator(id).expect("a checked id is the form's").stroke_mm;
+                let stroke = form.axis(id).expect("a checked id is the form's").stroke_mm;
                 // Targets are in hundredths of a millimetre.
                 let stroke = stroke + 0.005;
                 let mm = target.mm();

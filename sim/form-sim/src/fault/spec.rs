@@ -159,7 +159,7 @@ impl FaultSpec {
             }
         }
         for a in &self.actuators {
-            if form.actuator(&a.actuator).is_none() {
+            if form.axis(&a.actuator).is_none() {
                 let item = ActuatorItem(a).to_string();
                 return Err(error(&item, format!("the form has no actuator `{}`", a.actuator)));
             }
@@ -300,8 +300,10 @@ mod tests {
     fn names_are_checked_against_the_form() {
         let form = form_description::reference();
         assert!(SPEC.parse::<FaultSpec>().unwrap().check(&form).is_ok());
-        let error = "node9:reboot@1s".parse::<FaultSpec>().unwrap().check(&form).unwrap_err();
-        assert!(error.to_string().contains("no node 9"), "{error}");
+        let error = "node10:reboot@1s".parse::<FaultSpec>().unwrap().check(&form).unwrap_err();
+        assert!(error.to_string().contains("no node 10"), "{error}");
+        // A lift is an actuator like the panels': it can be stalled too.
+        assert!("height:stall@1s".parse::<FaultSpec>().unwrap().check(&form).is_ok());
         let error = "chest-l9:stall@1s".parse::<FaultSpec>().unwrap().check(&form).unwrap_err();
         assert!(error.to_string().contains("no actuator `chest-l9`"), "{error}");
     }

@@ -257,7 +257,7 @@ impl SimulatedForm {
                 silent: sim.is_silent(now),
             });
             for (actuator, truth) in Actuator::all().zip(sim.node.actuator_states(now)) {
-                let id = self.description.actuator_at(node, actuator).map(|a| a.id.clone());
+                let id = self.description.actuator_at(node, actuator).map(|a| a.id.to_string());
                 state.actuators.push(ActuatorTruth {
                     id: id.unwrap_or_default(),
                     node,

@@ -68,7 +68,7 @@ impl<T: Transport> Session<T> {
             let mut actuators: Vec<String> = events
                 .iter()
                 .filter(|e| !e.code.fault().is_empty())
-                .filter_map(|e| self.form.actuator_at(node, e.actuator?).map(|a| a.id.clone()))
+                .filter_map(|e| self.form.actuator_at(node, e.actuator?).map(|a| a.id.to_string()))
                 .collect();
             actuators.dedup();
             found.push((node, h.faults, actuators));
@@ -160,7 +160,7 @@ impl<T: Transport> Session<T> {
             for e in events {
                 let actuator = e
                     .actuator
-                    .and_then(|a| self.form.actuator_at(node, a).map(|spec| spec.id.clone()));
+                    .and_then(|a| self.form.actuator_at(node, a).map(|spec| spec.id.to_string()));
                 // An unknown code is a fault if the node is in Fault (firmware-protocol/README.md, "Faults and emergency events").
                 let is_fault = !e.code.fault().is_empty()
                     || (e.code != EmergencyCode::NO_ERROR
