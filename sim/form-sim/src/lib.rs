@@ -5,6 +5,7 @@
 //! - [`node`]: the simulated node, the node side of `firmware-protocol` as a pure state
 //!   machine.
 //! - [`fault`]: fault injection per run (bus, node, actuator) from one spec string.
+//! - [`garment`]: a garment on the form: its description and the load it puts on the panels.
 //! - [`bus`]: simulated buses: in-process CAN, serial and slcan over pseudo-terminals,
 //!   candump logs.
 //! - [`robot`]: the simulated robotic form: a form's nodes running on a bus, with faults and
@@ -13,6 +14,7 @@
 
 pub mod bus;
 pub mod fault;
+pub mod garment;
 pub mod node;
 pub mod robot;
 pub mod serve;

@@ -1,0 +1,272 @@
+//! The load a band puts on its ring's panels (see the module above for the model).
+
+use std::collections::BTreeMap;
+
+use form_description::{ActuatorSpec, FormDescription};
+
+use super::BandSpec;
+
+/// Millimetres per metre: tensions are per metre of band width, widths in mm.
+const MM_PER_M: f64 = 1000.0;
+/// kPa per N/mm².
+const KPA_PER_N_PER_MM2: f64 = 1000.0;
+
+/// What one panel carries.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PanelLoad {
+    /// Its actuator.
+    pub actuator: String,
+    /// The force pressing it inwards along its actuator, N.
+    pub force_n: f64,
+    /// Its share of the band: half of each skin edge at its ends times the band's width, mm²
+    /// (0 for a panel under its neighbours' skin, which the band does not touch).
+    pub area_mm2: f64,
+}
+
+impl PanelLoad {
+    /// The contact pressure, kPa: the force over the panel's share of the band.
+    pub fn pressure_kpa(&self) -> f64 {
+        if self.area_mm2 > 0.0 { KPA_PER_N_PER_MM2 * self.force_n / self.area_mm2 } else { 0.0 }
+    }
+}
+
+/// A band on its ring, at the form's actuator positions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BandLoad {
+    /// The ring.
+    pub ring: String,
+    /// The skin's girth, what the band is stretched to when tight, mm.
+    pub skin_girth_mm: f64,
+    /// The band's relaxed girth minus the skin's, mm: negative where the band is stretched.
+    pub ease_mm: f64,
+    /// Its strain, % (0 when loose).
+    pub strain_percent: f64,
+    /// Its tension, N per metre of width (0 when loose).
+    pub tension_n_per_m: f64,
+    /// The band's width, mm.
+    pub width_mm: f64,
+    /// Every panel of the ring.
+    pub panels: Vec<PanelLoad>,
+}
+
+impl BandLoad {
+    /// The mean pressure over the band, kPa: every panel's force over the band's area (the
+    /// skin's girth times its width); on a round ring Laplace's `2π T / C`.
+    pub fn mean_pressure_kpa(&self) -> f64 {
+        let force: f64 = self.panels.iter().map(|p| p.force_n).sum();
+        KPA_PER_N_PER_MM2 * force / (self.skin_girth_mm * self.width_mm)
+    }
+}
+
+/// The load `band` puts on the panels of its ring of `form` with the actuators at
+/// `positions_mm` (id → extension, mm; missing ones retracted); `None` for a ring without
+/// actuators.
+pub fn band_load(
+    form: &FormDescription,
+    band: &BandSpec,
+    positions_mm: &BTreeMap<String, f64>,
+) -> Option<BandLoad> {
+    let ring = form.ring(&band.ring)?;
+    let actuators: Vec<&ActuatorSpec> =
+        form.actuators.iter().filter(|a| a.ring == ring.name).collect();
+    if actuators.is_empty() {
+        return None;
+    }
+    // The panels' ends, each with its panel's index.
+    let mut ends = Vec::with_capacity(2 * actuators.len());
+    for (k, a) in actuators.iter().enumerate() {
+        let e = positions_mm.get(&a.id).copied().unwrap_or(0.0);
+        let [cx, cy] = ring.center_mm;
+        let [dx, dy] = a.direction();
+        let (r, half) = (a.base_radius_mm + e, 0.5 * a.panel_width_mm);
+        let middle = [cx + r * dx, cy + r * dy];
+        ends.push(([middle[0] + half * dy, middle[1] - half * dx], k));
+        ends.push(([middle[0] - half * dy, middle[1] + half * dx], k));
+    }
+    let skin = convex_hull(ends);
+    let n = skin.len();
+    let edge = |i: usize| sub(skin[(i + 1) % n].0, skin[i].0);
+    let skin_girth_mm: f64 = (0..n).map(|i| norm(edge(i))).sum();
+    let ease_mm = band.relaxed_girth_mm - skin_girth_mm;
+    let strain_percent = (100.0 * -ease_mm / band.relaxed_girth_mm).max(0.0);
+    let tension_n_per_m = band.stretch().tension(strain_percent);
+    let width_m = band.width_mm / MM_PER_M;
+    let mut panels: Vec<PanelLoad> = actuators
+        .iter()
+        .map(|a| PanelLoad { actuator: a.id.clone(), force_n: 0.0, area_mm2: 0.0 })
+        .collect();
+    for i in 0..n {
+        let (before, after) = (edge((i + n - 1) % n), edge(i));
+        let (l_in, l_out) = (norm(before), norm(after));
+        if l_in == 0.0 || l_out == 0.0 {
+            continue;
+        }
+        // The band pulls the corner along both edges: net T (out - in) per unit width.
+        let pull = sub(scale(after, 1.0 / l_out), scale(before, 1.0 / l_in));
+        let panel = &mut panels[skin[i].1];
+        let [dx, dy] = actuators[skin[i].1].direction();
+        let inward = -(pull[0] * dx + pull[1] * dy);
+        panel.force_n += tension_n_per_m * width_m * inward.max(0.0);
+        panel.area_mm2 += 0.5 * (l_in + l_out) * band.width_mm;
+    }
+    Some(BandLoad {
+        ring: ring.name.clone(),
+        skin_girth_mm,
+        ease_mm,
+        strain_percent,
+        tension_n_per_m,
+        width_mm: band.width_mm,
+        panels,
+    })
+}
+
+fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+fn scale(a: [f64; 2], k: f64) -> [f64; 2] {
+    [a[0] * k, a[1] * k]
+}
+
+fn norm(a: [f64; 2]) -> f64 {
+    a[0].hypot(a[1])
+}
+
+/// The convex hull of `points` (each with a tag), counter-clockwise, without collinear or
+/// repeated points (Andrew's monotone chain). Written here, not taken from the host: the
+/// simulator does not depend on it, and a skin is a handful of points.
+fn convex_hull<T: Copy>(mut points: Vec<([f64; 2], T)>) -> Vec<([f64; 2], T)> {
+    points.sort_by(|a, b| a.0[0].total_cmp(&b.0[0]).then(a.0[1].total_cmp(&b.0[1])));
+    if points.len() < 3 {
+        return points;
+    }
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let mut hull: Vec<([f64; 2], T)> = Vec::with_capacity(2 * points.len());
+    for pass in [false, true] {
+        let start = hull.len();
+        let ordered: Box<dyn Iterator<Item = &([f64; 2], T)>> =
+            if pass { Box::new(points.iter().rev()) } else { Box::new(points.iter()) };
+        for &p in ordered {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2].0, hull[hull.len() - 1].0, p.0) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::garment::{GarmentSpec, Stretch};
+    use std::f64::consts::TAU;
+
+    /// A round ring of 16 panels, 60 mm from the axis retracted, 20 mm wide.
+    fn round_form() -> FormDescription {
+        let mut spec = form_description::reference().into_spec();
+        spec.lifts.clear();
+        spec.nodes.retain(|n| n.address <= 2);
+        spec.rings.retain(|r| r.name == "chest");
+        spec.actuators = (0..16)
+            .map(|k| ActuatorSpec {
+                id: format!("p{k}"),
+                node: 1 + (k / 8) as u8,
+                channel: (k % 8) as u8,
+                ring: "chest".into(),
+                angle_deg: 22.5 * k as f64,
+                base_radius_mm: 60.0,
+                panel_width_mm: 20.0,
+                stroke_mm: 100.0,
+                max_speed_mm_s: 10.0,
+                max_accel_mm_s2: 50.0,
+                mirror: (k > 0 && k < 8).then(|| format!("p{}", 16 - k)),
+            })
+            .collect();
+        FormDescription::try_from(spec).unwrap()
+    }
+
+    fn garment(form: &FormDescription, band: &str) -> GarmentSpec {
+        GarmentSpec::from_toml_str(
+            &format!("name = \"t\"\n[[band]]\nring = \"chest\"\n{band}"),
+            form,
+        )
+        .unwrap()
+    }
+
+    /// On a round ring every panel presses with Laplace's `T / r` (here the 32-gon's corners
+    /// carry `2 T sin(θ/2)` for `T θ`: 0.6% under) and the mean is `2π T / C`.
+    #[test]
+    fn a_tight_band_on_a_round_ring_follows_laplaces_law() {
+        let form = round_form();
+        let positions: BTreeMap<String, f64> =
+            form.actuators.iter().map(|a| (a.id.clone(), 40.0)).collect();
+        let band = &garment(&form, "relaxed_girth_mm = 600.0\ntension_n_per_m_per_percent = 10.0")
+            .bands[0];
+        let load = band_load(&form, band, &positions).unwrap();
+        let strain = 100.0 * (load.skin_girth_mm - 600.0) / 600.0;
+        assert!((load.strain_percent - strain).abs() < 1e-9 && strain > 0.0);
+        assert!((load.ease_mm + load.skin_girth_mm - 600.0).abs() < 1e-9);
+        let laplace = TAU * load.tension_n_per_m / load.skin_girth_mm; // kPa: N/m over mm
+        assert!((load.mean_pressure_kpa() / laplace - 1.0).abs() < 0.01, "{load:?}");
+        for p in &load.panels {
+            assert!((p.pressure_kpa() / laplace - 1.0).abs() < 0.01, "{p:?} vs {laplace}");
+        }
+        // The forces add up to the band's: 2π T times its width, within the polygon's 0.6%.
+        let total: f64 = load.panels.iter().map(|p| p.force_n).sum();
+        let band_force = TAU * load.tension_n_per_m * band.width_mm / MM_PER_M;
+        assert!((total / band_force - 1.0).abs() < 0.01, "{total} vs {band_force}");
+    }
+
+    /// A band at least as long as the skin carries nothing.
+    #[test]
+    fn a_loose_band_carries_nothing() {
+        let form = round_form();
+        let band = &garment(&form, "relaxed_girth_mm = 900.0\ntension_n_per_m_per_percent = 10.0")
+            .bands[0];
+        let load = band_load(&form, band, &BTreeMap::new()).unwrap();
+        assert!(load.ease_mm > 0.0);
+        assert_eq!((load.strain_percent, load.tension_n_per_m), (0.0, 0.0));
+        assert!(load.panels.iter().all(|p| p.force_n == 0.0 && p.pressure_kpa() == 0.0));
+    }
+
+    /// A measured curve is read linearly between its points and along its last slope beyond.
+    #[test]
+    fn a_measured_curve_interpolates() {
+        let curve = Stretch::Measured { points: vec![[0.0, 0.0], [10.0, 60.0], [20.0, 150.0]] };
+        assert_eq!(curve.tension(-5.0), 0.0);
+        assert!((curve.tension(5.0) - 30.0).abs() < 1e-12);
+        assert!((curve.tension(15.0) - 105.0).abs() < 1e-12);
+        assert!((curve.tension(30.0) - 240.0).abs() < 1e-12);
+    }
+
+    /// Bad descriptions are refused with every problem named.
+    #[test]
+    fn bad_descriptions_name_the_band_and_field() {
+        let form = round_form();
+        let text = "name = \"t\"\n[[band]]\nring = \"knee\"\nrelaxed_girth_mm = -1\n\
+                    tension_n_per_m_per_percent = 1\n[[band]]\nring = \"chest\"\n\
+                    relaxed_girth_mm = 900\nforce_extension = [[0, 0], [10, 50], [5, 60]]\n";
+        let message = GarmentSpec::from_toml_str(text, &form).unwrap_err().to_string();
+        assert!(
+            message.contains("band `knee`: the form \"reference\" has no ring `knee`"),
+            "{message}"
+        );
+        assert!(
+            message.contains("band `knee`: `relaxed_girth_mm` = -1 must be a length"),
+            "{message}"
+        );
+        assert!(message.contains("band `chest`: `force_extension`: strain must rise"), "{message}");
+        let both = "name = \"t\"\n[[band]]\nring = \"chest\"\nrelaxed_girth_mm = 900\n";
+        let message = GarmentSpec::from_toml_str(both, &form).unwrap_err().to_string();
+        assert!(message.contains("one of the two"), "{message}");
+        let typo = "name = \"t\"\n[[band]]\nring = \"chest\"\nrelaxed_girth = 900\n";
+        let message = GarmentSpec::from_toml_str(typo, &form).unwrap_err().to_string();
+        assert!(message.contains("relaxed_girth"), "{message}");
+    }
+}
