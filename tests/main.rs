@@ -22,6 +22,7 @@ mod features;
 mod fitting;
 mod formats;
 mod fuzz_readers;
+mod heights_peer;
 mod makehuman;
 mod mannequin;
 mod mannequin_file;

@@ -8,9 +8,7 @@ pub mod makehuman_scan;
 pub mod quality;
 mod skip;
 
-pub use skip::or_skip;
-#[cfg(feature = "socketcan")] // python-can's peer of the SocketCAN tests
-pub use skip::python_modules;
+pub use skip::{or_skip, python_modules};
 
 /// The MakeHuman assets (`$DRESSFORM_MAKEHUMAN`, else `../shared/makehuman` beside the
 /// project), or `None` with a message when they are absent. With `DRESSFORM_REQUIRE_SHARED=1`

@@ -93,8 +93,9 @@ enum State {
     Free,
 }
 
-/// `argmin ‖A x - b‖²` over `0 <= x <= upper` by BVLS (see the module documentation).
-fn bounded_least_squares(a: &DMatrix<f64>, b: &DVector<f64>, upper: &[f64]) -> Vec<f64> {
+/// `argmin ‖A x - b‖²` over `0 <= x <= upper` by BVLS (see the module documentation); `upper`
+/// has one bound per column of `a`, each at least 0.
+pub fn bounded_least_squares(a: &DMatrix<f64>, b: &DVector<f64>, upper: &[f64]) -> Vec<f64> {
     let n = a.ncols();
     let mut x = vec![0.0; n];
     let mut state = vec![State::Lower; n];
