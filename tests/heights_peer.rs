@@ -25,7 +25,7 @@ impl Stream {
 fn problem(k: u64, s: &mut Stream) -> (DMatrix<f64>, DVector<f64>, Vec<f64>) {
     let rows = 1 + (s.next() * 10.0) as usize;
     let cols = 1 + (s.next() * 8.0) as usize;
-    let chain = k % 2 == 0;
+    let chain = k.is_multiple_of(2);
     let a = DMatrix::from_fn(rows, cols, |r, c| {
         let carried = if chain { c <= r } else { s.next() < 0.5 };
         if carried { 1.0 } else { 0.0 }
