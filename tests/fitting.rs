@@ -7,7 +7,9 @@
 use capture_sim::{BodyParams, generate};
 use dressform::body::mesh::Mesh;
 use dressform::body::scan::{self, frame::FrameOptions};
-use dressform::form::form_fit::{Placement, RingFit, RingStatus, fit, fit_by};
+use dressform::form::form_fit::{
+    Placement, RingFit, RingStatus, Targets, Tolerance, compare, fit, fit_by,
+};
 use dressform::run::pipeline::symmetrize;
 use dressform::shape::mannequin::MannequinOptions;
 use dressform::shape::profiles::Profiles;
@@ -126,6 +128,44 @@ fn a_customer_beyond_the_forms_range_is_reported_and_clamped() {
         "the shortfall is reported in the girths"
     );
     assert!(hip.saturated.iter().any(|s| s.beyond_mm > 0.0), "{:?}", hip.saturated);
+}
+
+/// A customer taller than the reference form's lifts reach (2.1 m, legs 47% of it, the
+/// thighs' level near 950 mm against the thigh rings' 870 at full stroke): the column stands
+/// at full stroke, the thighs stop 75 mm short of their level and the hip and abdomen short of
+/// theirs, every ring off its level has a lift at a stroke's end under it (the least squares
+/// then share what the strokes cannot give: the chest stands 6 mm above its level so that the
+/// shoulders, whose segment is at full stroke, come within 7 mm of theirs), the waist reaches
+/// its level, and the drive's check names the rings off their levels.
+#[test]
+fn a_customer_taller_than_the_lifts_reach_is_reported_ring_by_ring() {
+    let tall = BodyParams { height_mm: 2100.0, leg_length_mm: 987.0, ..BodyParams::default() };
+    let form = reference();
+    let fit = fit(&profiles_of(&tall), &form).unwrap();
+    assert_within_strokes(&fit);
+    for r in &fit.rings {
+        eprintln!("{:<12} {:+.1} mm", r.ring, r.offset_mm);
+        if r.offset_mm.abs() > 0.01 {
+            let full = |l: &form_description::LiftSpec| fit.lifts_mm[&l.id] == l.stroke_mm;
+            assert!(form.lifts_of(&r.ring).any(full), "{}: no lift at full stroke", r.ring);
+        }
+    }
+    assert_eq!(fit.lifts_mm["height"], form.lift("height").unwrap().stroke_mm);
+    let setpoints = fit.setpoints();
+    let targets = Targets {
+        girths_mm: &setpoints.target_girths_mm,
+        heights_mm: &setpoints.target_heights_mm,
+    };
+    let outcome = compare(&form, &fit.positions_mm, targets, Tolerance::default());
+    let summary = outcome.summary().unwrap();
+    assert!(summary.contains("mm below its level"), "{summary}");
+    let status =
+        |ring: &str| outcome.status(outcome.rings.iter().find(|r| r.ring == ring).unwrap());
+    assert!(status("thigh-l").contains("75 mm below its level"), "{}", status("thigh-l"));
+    assert!(!status("waist").contains("level"), "{}", status("waist"));
+    for (ring, r) in outcome.rings.iter().zip(&fit.rings) {
+        assert!((ring.height_error_mm() - r.offset_mm).abs() < 1e-6, "{}", r.ring);
+    }
 }
 
 fn arm(abduction: f64) -> capture_sim::ArmPose {
