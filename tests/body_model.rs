@@ -330,6 +330,19 @@ fn the_cli_builds_describes_and_samples_models() {
     {
         assert!(out.contains(word), "`model info` lacks {word}: {out}");
     }
+    // The same as JSON (issue 33), for scripts: its numbers are the table's.
+    let (code, json, err) = common::dressform(&["model", "info", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let info: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(info["file"], "built-in");
+    assert_eq!(info["bones"].as_array().unwrap().len(), 21);
+    let components = info["components"].as_array().unwrap();
+    assert_eq!(components.len(), 15);
+    let last = components.last().unwrap()["cumulative"].as_f64().unwrap();
+    assert!(last > 0.5 && last <= 1.0 + 1e-9, "{last}");
+    let first = &components[0];
+    let shown = format!("{:>10.2}", first["sigma_mm"].as_f64().unwrap());
+    assert!(out.contains(&shown), "{shown} not in the table: {out}");
     let body = dir.path().join("body.ply");
     let (code, _, err) = common::dressform(&[
         "model",

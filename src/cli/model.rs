@@ -52,6 +52,9 @@ struct BuildArgs {
 struct InfoArgs {
     /// A model file [default: the built-in model].
     model: Option<PathBuf>,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -167,22 +170,77 @@ fn read_meshes(
         .collect()
 }
 
+/// What `model info` says of a model (and, without its file, `model build`).
+#[derive(serde::Serialize)]
+struct Summary {
+    /// The file, or "built-in".
+    file: String,
+    /// Its size, bytes.
+    bytes: u64,
+    /// What it was built from, how many bodies, and the sampling seed if any.
+    source: String,
+    bodies: usize,
+    seed: Option<u64>,
+    vertices: usize,
+    triangles: usize,
+    /// The skeleton's bones, by name.
+    bones: Vec<String>,
+    /// Per principal component: its standard deviation (mm), the share of the variance it
+    /// explains and the cumulative share.
+    components: Vec<Component>,
+}
+
+#[derive(serde::Serialize)]
+struct Component {
+    sigma_mm: f64,
+    explained: f64,
+    cumulative: f64,
+}
+
+impl Summary {
+    fn of(model: &BodyModel, file: String, bytes: u64) -> Summary {
+        let p = &model.provenance;
+        let mut cumulative = 0.0;
+        let components = (model.sigmas.iter().zip(&model.explained))
+            .map(|(&sigma_mm, &explained)| {
+                cumulative += explained;
+                Component { sigma_mm, explained, cumulative }
+            })
+            .collect();
+        Summary {
+            file,
+            bytes,
+            source: p.source.clone(),
+            bodies: p.bodies,
+            seed: p.seed,
+            vertices: model.mean.len(),
+            triangles: model.triangles.len(),
+            bones: model.skeleton.names.clone(),
+            components,
+        }
+    }
+}
+
 fn print_summary(model: &BodyModel) {
-    let p = &model.provenance;
+    let s = Summary::of(model, String::new(), 0);
     outln!(
         "built from: {} ({} bodies{})",
-        p.source,
-        p.bodies,
-        p.seed.map_or(String::new(), |s| format!(", seed {s}"))
+        s.source,
+        s.bodies,
+        s.seed.map_or(String::new(), |s| format!(", seed {s}"))
     );
-    outln!("vertices: {}, triangles: {}", model.mean.len(), model.triangles.len());
-    outln!("bones ({}): {}", model.skeleton.names.len(), model.skeleton.names.join(" "));
-    outln!("components: k = {}", model.k());
+    outln!("vertices: {}, triangles: {}", s.vertices, s.triangles);
+    outln!("bones ({}): {}", s.bones.len(), s.bones.join(" "));
+    outln!("components: k = {}", s.components.len());
     outln!("  k  sigma (mm)  explained  cumulative");
-    let mut total = 0.0;
-    for (c, (s, e)) in model.sigmas.iter().zip(&model.explained).enumerate() {
-        total += e;
-        outln!("{:>3}  {:>10.2}  {:>8.2}%  {:>9.2}%", c, s, 100.0 * e, 100.0 * total);
+    for (k, c) in s.components.iter().enumerate() {
+        outln!(
+            "{:>3}  {:>10.2}  {:>8.2}%  {:>9.2}%",
+            k,
+            c.sigma_mm,
+            100.0 * c.explained,
+            100.0 * c.cumulative
+        );
     }
 }
 
@@ -192,11 +250,14 @@ fn info(args: &InfoArgs) -> Result<(), Failure> {
         Some(p) => std::fs::metadata(p).map_or(0, |m| m.len()),
         None => BodyModel::BUILTIN_GLB.len() as u64,
     };
-    outln!(
-        "file: {} ({size} bytes)",
-        args.model.as_ref().map_or("built-in".into(), |p| p.display().to_string())
-    );
-    print_summary(&model);
+    let file = args.model.as_ref().map_or("built-in".into(), |p| p.display().to_string());
+    if args.json {
+        let summary = Summary::of(&model, file, size);
+        outln!("{}", serde_json::to_string_pretty(&summary).map_err(Failure::other)?);
+    } else {
+        outln!("file: {file} ({size} bytes)");
+        print_summary(&model);
+    }
     Ok(())
 }
 
