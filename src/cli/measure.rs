@@ -103,8 +103,14 @@ fn print_text(m: &MeasureReport, at: &[f64]) {
     };
     let b = |name: &str, v: &dressform::shape::measure::Bilateral, unit: &str| {
         if v.difference.is_nan() {
-            // An arm raised too high to be followed down its loops.
-            outln!("  {name:<22} not measured (left {:.1}, right {:.1} {unit})", v.left, v.right)
+            // An arm raised too high to be followed down its loops, or a side held back as
+            // implausible (the warnings say why).
+            let side = |x: f64| if x.is_nan() { "-".to_string() } else { format!("{x:.1}") };
+            outln!(
+                "  {name:<22} not measured (left {}, right {} {unit})",
+                side(v.left),
+                side(v.right)
+            )
         } else {
             outln!(
                 "  {name:<22} {:7.1} {unit} left, {:7.1} {unit} right ({:+.1})",

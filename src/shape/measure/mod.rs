@@ -31,6 +31,7 @@ mod compare;
 mod dimensions;
 mod neck_and_shoulders;
 mod plane;
+mod plausibility;
 mod scan_report;
 
 pub use arms::{ArmMeasures, ArmSection, UPPER_ARM_OF_STATURE, WRIST_FROM_FINGERTIP, arms};
@@ -43,6 +44,7 @@ pub use neck_and_shoulders::{
     MIDLINE_BAND_MM, NeckAndShoulders, PlaneMeasure, across_back_and_front, neck_and_shoulders,
 };
 pub use plane::{PlaneLoop, tape_arc};
+pub use plausibility::{MAX_SIDE_DIFFERENCE, Unreliable, WRIST_GIRTH_MM, hold_back};
 pub use scan_report::{MeasureReport, measure_scan};
 
 use crate::body::mesh::Mesh;

@@ -3,8 +3,8 @@
 //! dimensions, torso girths at heights asked for, and where a number is unreliable.
 
 use super::{
-    BodyDimensions, Girth, Levels, Measurements, contact_warnings, dimensions, find_levels,
-    measure_at, warnings,
+    BodyDimensions, Girth, Levels, Measurements, Unreliable, contact_warnings, dimensions,
+    find_levels, hold_back, measure_at, warnings,
 };
 use crate::body::regions::{Landmarks, RegionError};
 use crate::body::scan::Scan;
@@ -28,6 +28,9 @@ pub struct MeasureReport {
     pub at: Vec<Option<Girth>>,
     /// Where a number is unreliable.
     pub warnings: Vec<String>,
+    /// The measurements held back as implausible (NaN, `null`, in `dimensions`), each with its
+    /// value and the reason ([`super::hold_back`]).
+    pub unreliable: Vec<Unreliable>,
 }
 
 /// Measures `scan` (canonical frame, smoothed as the caller wants), with the torso girths at
@@ -46,8 +49,10 @@ pub fn measure_scan(scan: &Scan, at: &[f64]) -> Result<MeasureReport, RegionErro
         }
     };
     let measurements = measure_at(&body, &levels);
-    let dimensions = dimensions(&body, &levels);
+    let mut dimensions = dimensions(&body, &levels);
+    let unreliable = hold_back(&mut dimensions);
     let mut warnings = warnings(&scan.body, &levels);
+    warnings.extend(unreliable.iter().map(Unreliable::to_string));
     warnings.extend(contact_warnings(body.landmarks(), &levels));
     warnings.extend(fallbacks);
     let at = body
@@ -64,5 +69,6 @@ pub fn measure_scan(scan: &Scan, at: &[f64]) -> Result<MeasureReport, RegionErro
         dimensions,
         at,
         warnings,
+        unreliable,
     })
 }

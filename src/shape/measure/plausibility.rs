@@ -1,0 +1,142 @@
+//! Plausibility limits (issue 33): a number no adult body has is not printed as a
+//! measurement. A measurement outside its limit, or a pair whose two sides differ by more than
+//! a body's do, becomes NaN (`null` in JSON) with the reason kept beside it
+//! ([`Unreliable`]), and a warning names the measurement and the cause: on posed scans an arm's
+//! cross-section can be cut through the hand or the torso (a 57.7 mm wrist on a 1.87 m body
+//! whose other wrist measured 203.3 mm).
+
+use std::ops::RangeInclusive;
+
+use serde::Serialize;
+
+use super::{Bilateral, BodyDimensions};
+
+/// An adult wrist's girth, mm: issue 33's plausibility range for the wrist (adult wrists lie
+/// well inside it; a section through the hand or the forearm's end leaves it).
+pub const WRIST_GIRTH_MM: RangeInclusive<f64> = 100.0..=250.0;
+
+/// The most the two sides of one body differ, relative to their mean: 20% (issue 33's
+/// limit); a body's left and right girths and lengths differ by a few percent.
+pub const MAX_SIDE_DIFFERENCE: f64 = 0.20;
+
+/// A measurement held back, and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Unreliable {
+    /// Its name in the report's JSON (`wrist_girth_mm.right`).
+    pub measurement: String,
+    /// The number that was measured.
+    pub value: f64,
+    /// Why it is not reported.
+    pub reason: String,
+}
+
+impl std::fmt::Display for Unreliable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} {:.1}: {}; not reported", self.measurement, self.value, self.reason)
+    }
+}
+
+/// Holds back every measurement of `d` outside its limit (set to NaN), and returns each with
+/// its reason.
+pub fn hold_back(d: &mut BodyDimensions) -> Vec<Unreliable> {
+    let mut held = Vec::new();
+    range("wrist_girth_mm", &mut d.wrist_girth_mm, &WRIST_GIRTH_MM, &mut held);
+    let sides: [(&str, &mut Bilateral); 7] = [
+        ("thigh_girth_mm", &mut d.thigh_girth_mm),
+        ("knee_girth_mm", &mut d.knee_girth_mm),
+        ("calf_girth_mm", &mut d.calf_girth_mm),
+        ("ankle_girth_mm", &mut d.ankle_girth_mm),
+        ("upper_arm_girth_mm", &mut d.upper_arm_girth_mm),
+        ("wrist_girth_mm", &mut d.wrist_girth_mm),
+        ("arm_length_mm", &mut d.arm_length_mm),
+    ];
+    for (name, pair) in sides {
+        alike(name, pair, &mut held);
+    }
+    held
+}
+
+/// Each side of `pair` outside `limit`, held back.
+fn range(
+    name: &str,
+    pair: &mut Bilateral,
+    limit: &RangeInclusive<f64>,
+    held: &mut Vec<Unreliable>,
+) {
+    for (side, value) in [("left", &mut pair.left), ("right", &mut pair.right)] {
+        if value.is_finite() && !limit.contains(value) {
+            held.push(Unreliable {
+                measurement: format!("{name}.{side}"),
+                value: *value,
+                reason: format!(
+                    "outside {:.0}-{:.0} mm, an adult's range (the section may cut the hand or \
+                     the torso: a posed arm; `reconstruct` re-poses the scan)",
+                    limit.start(),
+                    limit.end()
+                ),
+            });
+            *value = f64::NAN;
+        }
+    }
+    pair.difference = pair.left - pair.right;
+}
+
+/// Both sides of `pair` held back when they differ by more than [`MAX_SIDE_DIFFERENCE`] of
+/// their mean: one of them is wrong, and the numbers do not say which.
+fn alike(name: &str, pair: &mut Bilateral, held: &mut Vec<Unreliable>) {
+    let mean = 0.5 * (pair.left + pair.right);
+    if !(pair.difference.is_finite() && pair.difference.abs() > MAX_SIDE_DIFFERENCE * mean) {
+        return;
+    }
+    let reason = format!(
+        "left {:.1} and right {:.1} differ by {:.0}%, more than a body's {:.0}% (a posed or \
+         touching limb; `reconstruct` re-poses the scan)",
+        pair.left,
+        pair.right,
+        100.0 * pair.difference.abs() / mean,
+        100.0 * MAX_SIDE_DIFFERENCE
+    );
+    for (side, value) in [("left", &mut pair.left), ("right", &mut pair.right)] {
+        held.push(Unreliable {
+            measurement: format!("{name}.{side}"),
+            value: *value,
+            reason: reason.clone(),
+        });
+        *value = f64::NAN;
+    }
+    pair.difference = f64::NAN;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pair(left: f64, right: f64) -> Bilateral {
+        Bilateral::new(left, right)
+    }
+
+    /// Issue 33's wrist: 203.3 mm left, 57.7 mm right. The right is held back with its
+    /// reason, the left kept; a pair 25% apart is held back whole; 15% apart is kept.
+    #[test]
+    fn an_implausible_wrist_and_sides_too_unlike_are_held_back() {
+        let mut wrist = pair(203.3, 57.7);
+        let mut held = Vec::new();
+        range("wrist_girth_mm", &mut wrist, &WRIST_GIRTH_MM, &mut held);
+        assert_eq!(wrist.left, 203.3);
+        assert!(wrist.right.is_nan() && wrist.difference.is_nan());
+        assert_eq!(held.len(), 1);
+        assert_eq!(held[0].measurement, "wrist_girth_mm.right");
+        assert!(held[0].to_string().contains("57.7: outside 100-250 mm"), "{}", held[0]);
+        // The remaining side alone is not compared.
+        alike("wrist_girth_mm", &mut wrist, &mut held);
+        assert_eq!((held.len(), wrist.left), (1, 203.3));
+
+        let mut calf = pair(400.0, 310.0);
+        alike("calf_girth_mm", &mut calf, &mut held);
+        assert!(calf.left.is_nan() && calf.right.is_nan());
+        assert!(held[1].reason.contains("differ by 25%, more than a body's 20%"), "{}", held[1]);
+        let mut thigh = pair(560.0, 480.0);
+        alike("thigh_girth_mm", &mut thigh, &mut held);
+        assert_eq!((thigh.left, thigh.right, held.len()), (560.0, 480.0, 3));
+    }
+}
