@@ -282,6 +282,19 @@ impl ActuatorSpec {
         let angle = self.angle_deg.to_radians();
         [angle.sin(), -angle.cos()]
     }
+
+    /// The two ends of its panel (a plate of `panel_width_mm`, tangential) in the X-Y plane
+    /// with the ring's axis at `centre` and the actuator at `extension_mm`: clockwise end
+    /// first, seen from above. The skin over a ring is the convex hull of its panels' ends.
+    pub fn panel_ends(&self, centre: [f64; 2], extension_mm: f64) -> [[f64; 2]; 2] {
+        let [dx, dy] = self.direction();
+        let (r, half) = (self.base_radius_mm + extension_mm, 0.5 * self.panel_width_mm);
+        let middle = [centre[0] + r * dx, centre[1] + r * dy];
+        [
+            [middle[0] + half * dy, middle[1] - half * dx],
+            [middle[0] - half * dy, middle[1] + half * dx],
+        ]
+    }
 }
 
 impl Deref for FormDescription {

@@ -69,24 +69,17 @@ pub struct RingLevels {
 impl RingLevels {
     /// The levels of `form`'s rings on the mannequin of `profiles`.
     pub fn new(profiles: &Profiles, form: &FormDescription) -> Self {
-        let mut pairs: Vec<(f64, f64)> = form
-            .rings
-            .iter()
-            .filter_map(|r| {
-                r.anchor.filter(|a| !a.is_leg()).map(|a| (r.height_mm, level(a, profiles)))
-            })
+        // Each anchored ring's level, found once (the under-bust's looks through the layers).
+        let anchored: Vec<Option<f64>> =
+            form.rings.iter().map(|r| r.anchor.map(|a| level(a, profiles))).collect();
+        let mut pairs: Vec<(f64, f64)> = (form.rings.iter().zip(&anchored))
+            .filter(|(r, _)| r.anchor.is_some_and(|a| !a.is_leg()))
+            .filter_map(|(r, z)| Some((r.height_mm, (*z)?)))
             .collect();
         pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
         pairs.dedup_by(|a, b| a.0 == b.0);
-        let by_ring = form
-            .rings
-            .iter()
-            .map(|r| {
-                let z = r
-                    .anchor
-                    .map_or_else(|| interpolate(&pairs, r.height_mm), |a| level(a, profiles));
-                (r.name.clone(), z)
-            })
+        let by_ring = (form.rings.iter().zip(anchored))
+            .map(|(r, z)| (r.name.clone(), z.unwrap_or_else(|| interpolate(&pairs, r.height_mm))))
             .collect();
         RingLevels { by_ring }
     }

@@ -149,12 +149,7 @@ fn skin_points(centre: DVec2, actuators: &[&ActuatorSpec], extensions: &[f64]) -
     actuators
         .iter()
         .zip(extensions)
-        .flat_map(|(a, e)| {
-            let d = DVec2::from_array(a.direction());
-            let middle = centre + d * (a.base_radius_mm + e);
-            let half = d.perp() * (0.5 * a.panel_width_mm);
-            [middle - half, middle + half]
-        })
+        .flat_map(|(a, &e)| a.panel_ends(centre.to_array(), e).map(DVec2::from_array))
         .collect()
 }
 

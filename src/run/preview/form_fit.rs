@@ -184,15 +184,12 @@ fn ring_cells(
             }
             outline(&mut canvas, skin, SKIN_LINE, SKIN_DEPTH);
             for a in form.actuators.iter().filter(|a| a.ring == ring.name) {
-                let d = DVec2::from_array(a.direction());
                 let e = fit.positions_mm.get(&a.id).copied().unwrap_or(0.0);
-                let middle = *centre + d * (a.base_radius_mm + e);
-                let half_panel = d.perp() * (0.5 * a.panel_width_mm);
+                let [p, q] = a
+                    .panel_ends(ring.center_mm, e)
+                    .map(|end| at(DVec2::from_array(end), PANEL_DEPTH));
                 let gap = r.panel_gaps_mm.get(&a.id).copied().unwrap_or(0.0);
-                let colour = gap_colour(gap);
-                let (p, q) =
-                    (at(middle - half_panel, PANEL_DEPTH), at(middle + half_panel, PANEL_DEPTH));
-                canvas.line(p, q, PANEL_PX * ss, colour);
+                canvas.line(p, q, PANEL_PX * ss, gap_colour(gap));
             }
             let lines = [
                 format!("{} z{:.0} {:+.1}", r.ring, r.form_height_mm, r.offset_mm),

@@ -76,12 +76,7 @@ pub fn band_load(
     let mut ends = Vec::with_capacity(2 * actuators.len());
     for (k, a) in actuators.iter().enumerate() {
         let e = positions_mm.get(&a.id).copied().unwrap_or(0.0);
-        let [cx, cy] = ring.center_mm;
-        let [dx, dy] = a.direction();
-        let (r, half) = (a.base_radius_mm + e, 0.5 * a.panel_width_mm);
-        let middle = [cx + r * dx, cy + r * dy];
-        ends.push(([middle[0] + half * dy, middle[1] - half * dx], k));
-        ends.push(([middle[0] - half * dy, middle[1] + half * dx], k));
+        ends.extend(a.panel_ends(ring.center_mm, e).map(|end| (end, k)));
     }
     let skin = convex_hull(ends);
     let n = skin.len();
