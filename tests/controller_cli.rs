@@ -93,7 +93,7 @@ fn status_lists_every_node_and_estop_needs_a_link() {
     assert!(out.status.success(), "{stdout}");
     for node in 1..=9 {
         assert!(
-            stdout.contains(&format!("node {node}: Disabled (protocol 1.0, firmware 1.0.0)")),
+            stdout.contains(&format!("node {node}: Disabled (protocol 1.1, firmware 1.0.0)")),
             "{stdout}"
         );
     }

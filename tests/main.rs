@@ -19,6 +19,7 @@ mod controller_socketcan;
 mod demo;
 mod determinism;
 mod features;
+mod fit_test;
 mod fitting;
 mod formats;
 mod fuzz_readers;

@@ -1,5 +1,6 @@
-//! Actuators of a node, sets of them, positions along their stroke, and their speed and
-//! acceleration limits ([`Speed`] in 0.01 mm/s, [`Accel`] in 0.1 mm/s²).
+//! Actuators of a node, sets of them, positions along their stroke, their speed and
+//! acceleration limits ([`Speed`] in 0.01 mm/s, [`Accel`] in 0.1 mm/s²), and the forces they
+//! measure ([`Force`] in 0.01 N, protocol 1.1).
 //!
 //! A node drives at most [`MAX_ACTUATORS`] (8) linear actuators, numbered 0..=7. A board with
 //! more actuators presents itself as several nodes (as ODrive does with its two axes).
@@ -211,6 +212,62 @@ impl Accel {
     }
 }
 
+/// Hundredths of a newton in one: the wire's unit of force (protocol 1.1).
+pub const HUNDREDTHS_PER_N: f64 = 100.0;
+
+/// The wire value of "no force measured" (`None`): the most negative `i16`.
+pub(crate) const NO_FORCE: i16 = i16::MIN;
+
+/// A force an actuator measures (protocol 1.1), in the wire's unit of **0.01 N**, signed:
+/// positive when the load pushes the panel inwards, towards home (a garment squeezing the
+/// form), negative when it pulls it outwards. −327.67..=327.67 N; the wire value `0x8000`
+/// is reserved and means "not measured" (`None`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Force(i16);
+
+impl Force {
+    /// No load.
+    pub const ZERO: Self = Self(0);
+    /// The largest force the wire carries, 327.67 N.
+    pub const MAX: Self = Self(i16::MAX);
+
+    /// The force `hundredths_n` × 0.01 N, unless it is the reserved `i16::MIN`.
+    pub const fn new(hundredths_n: i16) -> Option<Self> {
+        if hundredths_n == NO_FORCE { None } else { Some(Self(hundredths_n)) }
+    }
+
+    /// The force rounded to 0.01 N and saturated at ±327.67 N (a sensor reads its full
+    /// scale beyond its range); `None` for NaN.
+    pub fn from_n(n: f64) -> Option<Self> {
+        if n.is_nan() {
+            return None;
+        }
+        let max = f64::from(i16::MAX);
+        let hundredths = (n * HUNDREDTHS_PER_N).clamp(-max, max);
+        // Rounding half away from zero by hand (`f64::round` needs std): |x| ≤ 32767.
+        let rounded = if hundredths < 0.0 { hundredths - 0.5 } else { hundredths + 0.5 };
+        Some(Self(rounded as i16))
+    }
+
+    /// The force in 0.01 N (the wire value).
+    pub const fn hundredths_n(self) -> i16 {
+        self.0
+    }
+
+    /// The force in newtons.
+    pub fn n(self) -> f64 {
+        f64::from(self.0) / HUNDREDTHS_PER_N
+    }
+}
+
+/// The wire value of a force slot.
+pub(crate) const fn force_to_wire(force: Option<Force>) -> i16 {
+    match force {
+        Some(f) => f.0,
+        None => NO_FORCE,
+    }
+}
+
 /// The wire value of a position slot.
 pub(crate) const fn position_to_wire(position: Option<Position>) -> u16 {
     match position {
@@ -251,6 +308,19 @@ mod tests {
         assert!(!set.contains(Actuator::new(0).unwrap()));
         assert_eq!(set.iter().map(Actuator::index).collect::<Vec<_>>(), [1, 6]);
         assert!(ActuatorSet::EMPTY.is_empty() && !ActuatorSet::ALL.is_empty());
+    }
+
+    #[test]
+    fn forces_round_to_hundredths_saturate_and_reserve_0x8000() {
+        assert_eq!(Force::from_n(12.345).map(Force::hundredths_n), Some(1235));
+        assert_eq!(Force::from_n(-0.004).map(Force::hundredths_n), Some(0));
+        assert_eq!(Force::from_n(-1.006).map(Force::hundredths_n), Some(-101));
+        assert_eq!(Force::from_n(1e9), Some(Force::MAX));
+        assert_eq!(Force::from_n(-1e9).map(Force::hundredths_n), Some(-i16::MAX));
+        assert_eq!(Force::from_n(f64::NAN), None);
+        assert_eq!(Force::new(i16::MIN), None);
+        assert_eq!(force_to_wire(None), i16::MIN);
+        assert_eq!(Force::new(-250).map(Force::n), Some(-2.5));
     }
 
     #[test]

@@ -14,10 +14,11 @@
 //! | feedback       | 6..=8  | 0x181..=0x23F   |
 //! | heartbeats     | 9, 10  | 0x240..=0x2BF   |
 //! | configuration  | 11..=20| 0x2C0..=0x53F   |
+//! | forces (1.1)   | 21..=23| 0x541..=0x5FF   |
 //!
 //! **Payload**: the message's [`payload`] layout, little-endian, the data
-//! length equal to the layout length (at most 8 bytes). `AllTargets` and `AllFeedback`
-//! (16 bytes) travel in CAN FD frames, sent with bit-rate switching; every other message is a
+//! length equal to the layout length (at most 8 bytes). `AllTargets`, `AllFeedback` and
+//! `AllForce` (16 bytes) travel in CAN FD frames, sent with bit-rate switching; every other message is a
 //! classic frame. Send them only on a CAN FD bus, where every controller is FD-capable (a
 //! classic controller answers an FD frame with error frames); on classic CAN use the halves.
 //!
@@ -151,7 +152,7 @@ mod tests {
     use crate::message::{Message, NodeId, Positions8, Sync};
 
     /// The priority classes of the README, highest first.
-    const CLASSES: [&[Code]; 7] = [
+    const CLASSES: [&[Code]; 8] = [
         &[Code::EmergencyStop],
         &[Code::Sync],
         &[Code::Emergency],
@@ -170,6 +171,7 @@ mod tests {
             Code::ParamValue,
             Code::Ack,
         ],
+        &[Code::ForceLower, Code::ForceUpper, Code::AllForce],
     ];
 
     fn ids(codes: &[Code]) -> impl Iterator<Item = u16> + '_ {
@@ -195,6 +197,11 @@ mod tests {
         assert!(ids(&Code::ALL).all(|id| id < 0x7F0));
         assert_eq!(id(Code::EmergencyStop, Address::Broadcast).as_raw(), 0x000);
         assert_eq!(id(Code::Sync, Address::Broadcast).as_raw(), 0x040);
+        // The forces of 1.1, the lowest class: 0x541 (node 1's ForceLower) ..= 0x5FF.
+        let node = |n| Address::Node(NodeId::new(n).unwrap());
+        assert_eq!(id(Code::ForceLower, node(1)).as_raw(), 0x541);
+        assert_eq!(id(Code::AllForce, node(63)).as_raw(), 0x5FF);
+        assert_eq!(ids(&Code::ALL).max(), Some(0x5FF));
     }
 
     #[test]
@@ -224,7 +231,12 @@ mod tests {
         let frame = |raw, data: &[u8]| Frame::new(StandardId::new(raw).unwrap(), data).unwrap();
         assert_eq!(decode(&frame(0x001, &[])), Err(Error::InvalidAddress));
         assert_eq!(decode(&frame(0x0C0, &[0; 8])), Err(Error::InvalidAddress));
-        assert_eq!(decode(&frame(0x540, &[])), Err(Error::UnknownCode(21)));
+        // Node messages from address 0: 0x540 (ForceLower), 0x5C0 (AllForce).
+        assert_eq!(decode(&frame(0x540, &[0; 8])), Err(Error::InvalidAddress));
+        assert_eq!(decode(&frame(0x5C0, &[0; 16])), Err(Error::InvalidAddress));
+        // The first unknown code, 24: ids 0x600..=0x63F.
+        assert_eq!(decode(&frame(0x600, &[])), Err(Error::UnknownCode(24)));
+        assert_eq!(decode(&frame(0x7EF, &[])), Err(Error::UnknownCode(31)));
         assert_eq!(decode(&frame(0x000, &[1, 2])), Ok(Packet::broadcast(Message::EmergencyStop)));
     }
 }

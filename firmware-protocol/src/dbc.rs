@@ -10,7 +10,7 @@
 
 use core::fmt::{self, Write};
 
-use crate::actuator::{actuator_to_wire, position_to_wire};
+use crate::actuator::{actuator_to_wire, force_to_wire, position_to_wire};
 use crate::drive::{EmergencyCode, Faults};
 use crate::message::{Addressing, Code, Direction, Message};
 use crate::param::ParamId;
@@ -85,6 +85,7 @@ pub const MAX_SIGNALS: usize = 16;
 const KEEP: &[(i64, &str)] = &[(0xFFFF, "Keep")];
 const UNKNOWN: &[(i64, &str)] = &[(0xFFFF, "Unknown")];
 const NODE: &[(i64, &str)] = &[(0xFF, "Node")];
+const NOT_MEASURED: &[(i64, &str)] = &[(i16::MIN as i64, "NotMeasured")];
 const STATES: &[(i64, &str)] = &[(0, "Disabled"), (1, "Enabled"), (2, "Homing"), (3, "Fault")];
 const COMMANDS: &[(i64, &str)] = &[(0, "Disable"), (1, "Enable"), (2, "FaultReset"), (3, "Halt")];
 const STATUSES: &[(i64, &str)] = &[
@@ -128,6 +129,13 @@ const fn target(name: &'static str, start: u16) -> Signal {
     Signal::new(name, start, 16, "Staged target; Keep = leave this actuator's staged target")
         .unit("mm", 2)
         .choices(KEEP)
+}
+
+const fn force(name: &'static str, start: u16) -> Signal {
+    Signal::new(name, start, 16, "Measured force, positive inwards; NotMeasured = no sensor")
+        .unit("N", 2)
+        .signed()
+        .choices(NOT_MEASURED)
 }
 
 const fn actual(name: &'static str, start: u16) -> Signal {
@@ -273,7 +281,8 @@ pub const MESSAGES: [MessageDef; Code::ALL.len()] = [
             Signal::new("FaultLimitSwitch", 15, 1, "End switch hit outside homing"),
             Signal::new("FaultHomingFailed", 16, 1, "Homing failed"),
             Signal::new("FaultInternal", 17, 1, "Firmware error"),
-            Signal::new("FaultReserved", 18, 6, "Fault bits 10..15, reserved (0)"),
+            Signal::new("FaultOverForce", 18, 1, "Force over ForceLimit, actuator stalled (1.1)"),
+            Signal::new("FaultReserved", 19, 5, "Fault bits 11..15, reserved (0)"),
             Signal::new("Homed", 24, 8, "Actuators homed (bit i = actuator i)"),
             Signal::new("Moving", 32, 8, "Actuators moving (bit i = actuator i)"),
             Signal::new("Staged", 40, 8, "Actuators with a staged target (bit i = actuator i)"),
@@ -357,6 +366,43 @@ pub const MESSAGES: [MessageDef; Code::ALL.len()] = [
             Signal::new("Status", 8, 8, "Outcome").choices(STATUSES),
         ],
     },
+    MessageDef {
+        code: Code::ForceLower,
+        comment: "Measured forces of actuators 0..3 (protocol 1.1; cyclic on classic CAN)",
+        cycle_ms: Some(FEEDBACK_PERIOD_MS),
+        signals: &[
+            force("Force0", 0),
+            force("Force1", 16),
+            force("Force2", 32),
+            force("Force3", 48),
+        ],
+    },
+    MessageDef {
+        code: Code::ForceUpper,
+        comment: "Measured forces of actuators 4..7 (protocol 1.1; cyclic on classic CAN)",
+        cycle_ms: Some(FEEDBACK_PERIOD_MS),
+        signals: &[
+            force("Force4", 0),
+            force("Force5", 16),
+            force("Force6", 32),
+            force("Force7", 48),
+        ],
+    },
+    MessageDef {
+        code: Code::AllForce,
+        comment: "Measured forces of actuators 0..7 (protocol 1.1; cyclic on CAN FD, instead of the halves)",
+        cycle_ms: Some(FEEDBACK_PERIOD_MS),
+        signals: &[
+            force("Force0", 0),
+            force("Force1", 16),
+            force("Force2", 32),
+            force("Force3", 48),
+            force("Force4", 64),
+            force("Force5", 80),
+            force("Force6", 96),
+            force("Force7", 112),
+        ],
+    },
 ];
 
 /// The DBC description of the messages with `code`.
@@ -416,6 +462,8 @@ pub fn signal_values(message: &Message) -> heapless::Vec<i64, MAX_SIGNALS> {
             push(&[m.param.0.into(), actuator_to_wire(m.actuator).into(), m.value.into()]);
         }
         Message::Ack(m) => push(&[m.request as i64, m.status as i64]),
+        Message::Force(m) => push(&m.forces.map(|f| i64::from(force_to_wire(f)))),
+        Message::AllForce(m) => push(&m.forces.map(|f| i64::from(force_to_wire(f)))),
     }
     values
 }

@@ -17,8 +17,9 @@
 //! * **Homing**: the actuators named by `Home` seek their home switch, then the node
 //!   returns to Enabled (or to Fault with [`Faults::HOMING_FAILED`]).
 //! * **Fault**: a fault sets a bit of [`Faults`] and the node sends an `Emergency` with the
-//!   matching [`EmergencyCode`]; moving actuators stop at their acceleration limit, the power
-//!   stage turns off and staged targets are dropped. `FaultReset` clears the faults whose
+//!   matching [`EmergencyCode`]; moving actuators stop at their acceleration limit (one over
+//!   its force limit, [`Faults::OVER_FORCE`], at once), the power stage turns off and staged
+//!   targets are dropped. `FaultReset` clears the faults whose
 //!   cause is gone; when none is left the node goes to Disabled and sends `Emergency`
 //!   [`EmergencyCode::NO_ERROR`].
 //!
@@ -78,7 +79,7 @@ impl DriveCommand {
 }
 
 bitflags! {
-    /// The faults latched by a node (heartbeat field, `u16`). Bits 10..=15 are reserved:
+    /// The faults latched by a node (heartbeat field, `u16`). Bits 11..=15 are reserved:
     /// senders set them to 0, receivers keep and report them (a newer minor version may
     /// define them).
     #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -103,6 +104,8 @@ bitflags! {
         const HOMING_FAILED = 1 << 8;
         /// Firmware error (assertion, watchdog reset, corrupted configuration).
         const INTERNAL = 1 << 9;
+        /// An actuator felt more than its `ForceLimit` and stalled (protocol 1.1).
+        const OVER_FORCE = 1 << 10;
     }
 }
 
@@ -136,6 +139,9 @@ impl EmergencyCode {
     pub const EMERGENCY_STOP: Self = Self(0xFF01);
     /// Fault: homing failed; detail = distance travelled in 0.01 mm.
     pub const HOMING_FAILED: Self = Self(0xFF02);
+    /// Fault (protocol 1.1): an actuator felt more than its `ForceLimit`, stopped where it
+    /// was and holds; detail = the force in 0.01 N.
+    pub const OVER_FORCE: Self = Self(0xFF03);
     /// Warning: a target lies outside the actuator's soft limits and was not staged;
     /// detail = the target in 0.01 mm.
     pub const TARGET_OUT_OF_RANGE: Self = Self(0xFF10);
@@ -146,7 +152,7 @@ impl EmergencyCode {
     pub const DURATION_TOO_SHORT: Self = Self(0xFF12);
 
     /// The codes this version defines, with their names.
-    pub const KNOWN: [(Self, &'static str); 14] = [
+    pub const KNOWN: [(Self, &'static str); 15] = [
         (Self::NO_ERROR, "NoError"),
         (Self::OVERCURRENT, "Overcurrent"),
         (Self::OVERVOLTAGE, "Overvoltage"),
@@ -158,6 +164,7 @@ impl EmergencyCode {
         (Self::LIMIT_SWITCH, "LimitSwitch"),
         (Self::EMERGENCY_STOP, "EmergencyStop"),
         (Self::HOMING_FAILED, "HomingFailed"),
+        (Self::OVER_FORCE, "OverForce"),
         (Self::TARGET_OUT_OF_RANGE, "TargetOutOfRange"),
         (Self::NOT_HOMED, "NotHomed"),
         (Self::DURATION_TOO_SHORT, "DurationTooShort"),
@@ -176,6 +183,7 @@ impl EmergencyCode {
             Self::LIMIT_SWITCH => Faults::LIMIT_SWITCH,
             Self::EMERGENCY_STOP => Faults::EMERGENCY_STOP,
             Self::HOMING_FAILED => Faults::HOMING_FAILED,
+            Self::OVER_FORCE => Faults::OVER_FORCE,
             _ => Faults::empty(),
         }
     }

@@ -6,14 +6,14 @@
 //! mappings:
 //!
 //! * [`can`]: classic CAN 2.0A (11-bit ids ordered by priority, ≤ 8-byte little-endian
-//!   payloads) with CAN FD for the two 16-byte messages; frames implement
+//!   payloads) with CAN FD for the three 16-byte messages; frames implement
 //!   [`embedded_can::Frame`]. [`dbc`] describes it for CAN tools; [`slcan`] is the text
 //!   of a classic frame on USB-CAN adapters.
 //! * [`serial`]: the same packets over a byte stream, with address, sequence number, CRC and
 //!   COBS framing, and a streaming [`serial::Decoder`].
 //!
 //! The rest names domain concepts: [`message`] (what is said, by whom), [`payload`] (the
-//! byte layouts), [`actuator`] (actuators and positions), [`drive`] (the drive state
+//! byte layouts), [`actuator`] (actuators, positions and forces), [`drive`] (the drive state
 //! machine, faults, answers), [`param`] (parameters), [`timing`] (heartbeats, watchdog),
 //! [`version`] (compatibility rules), [`update`] (a synchronised full-form move) and
 //! [`budget`] (bus time of frames). `firmware-protocol/README.md` is the specification.
@@ -55,7 +55,8 @@ pub mod update;
 pub mod version;
 
 pub use actuator::{
-    Accel, Actuator, ActuatorSet, HUNDREDTHS_PER_MM, Position, Speed, TENTHS_PER_MM_S2,
+    Accel, Actuator, ActuatorSet, Force, HUNDREDTHS_PER_MM, HUNDREDTHS_PER_N, Position, Speed,
+    TENTHS_PER_MM_S2,
 };
 pub use error::Error;
 pub use message::{Address, Code, Message, NodeId, Packet};
@@ -66,7 +67,7 @@ pub use version::{PROTOCOL_VERSION, ProtocolVersion};
 pub enum Link {
     /// Classic CAN: payloads of at most 8 bytes (`Targets` / `Feedback` halves).
     ClassicCan,
-    /// CAN FD: 16-byte `AllTargets` / `AllFeedback` too.
+    /// CAN FD: 16-byte `AllTargets` / `AllFeedback` / `AllForce` too.
     CanFd,
     /// A serial line: any message, nodes speak only when polled.
     Serial,

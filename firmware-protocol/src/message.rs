@@ -8,11 +8,11 @@
 //! Host → node: `EmergencyStop`, `Sync`, `Targets`, `AllTargets`, `HostHeartbeat`,
 //! `Control`, `Home`, `MotionLimits`, `IdentifyRequest`, `ParamRead`, `ParamWrite`.
 //! Node → host: `Emergency`, `Feedback`, `AllFeedback`, `Heartbeat`, `Identity`,
-//! `Capabilities`, `ParamValue`, `Ack`. The byte layouts are in
-//! [`payload`](crate::payload).
+//! `Capabilities`, `ParamValue`, `Ack`, and since 1.1 `Force` and `AllForce`. The byte
+//! layouts are in [`payload`](crate::payload).
 
 use crate::Error;
-use crate::actuator::{Accel, Actuator, ActuatorSet, MAX_ACTUATORS, Position, Speed};
+use crate::actuator::{Accel, Actuator, ActuatorSet, Force, MAX_ACTUATORS, Position, Speed};
 use crate::drive::{AckStatus, DriveCommand, DriveState, EmergencyCode, Faults};
 use crate::param::ParamId;
 use crate::version::{FirmwareVersion, ProtocolVersion};
@@ -93,7 +93,7 @@ macro_rules! codes {
     ($($(#[$doc:meta])* $name:ident = $value:literal, $dir:ident, $addr:ident, $len:literal,
        [$($answer:ident),*];)*) => {
         /// The function code of a message (5 bits): its CAN priority class and its identity
-        /// on every mapping. Codes 21..=30 are free for minor versions; 31 is never used (it
+        /// on every mapping. Codes 24..=30 are free for minor versions; 31 is never used (it
         /// would make CAN ids 0x7F0..=0x7FF, which old controllers reject).
         #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
         #[repr(u8)]
@@ -173,7 +173,8 @@ codes! {
     /// Actual positions of all eight actuators (CAN FD / serial).
     AllFeedback = 8, NodeToHost, Node, 16, [];
     /// The host is alive (feeds the node watchdogs; addressed, it polls one node, which
-    /// answers with its heartbeat and positions).
+    /// answers with its heartbeat and positions, then, to a host of 1.1, its forces: not
+    /// listed among the answers, since a 1.0 node does not send them).
     HostHeartbeat = 9, HostToNode, NodeOrBroadcast, 2, [Heartbeat, AllFeedback];
     /// A node's state, faults and actuator status.
     Heartbeat = 10, NodeToHost, Node, 6, [];
@@ -197,6 +198,23 @@ codes! {
     ParamValue = 19, NodeToHost, Node, 7, [];
     /// The outcome of a request.
     Ack = 20, NodeToHost, Node, 2, [];
+    /// Measured forces of actuators 0..=3 (protocol 1.1).
+    ForceLower = 21, NodeToHost, Node, 8, [];
+    /// Measured forces of actuators 4..=7 (protocol 1.1).
+    ForceUpper = 22, NodeToHost, Node, 8, [];
+    /// Measured forces of all eight actuators (CAN FD / serial; protocol 1.1).
+    AllForce = 23, NodeToHost, Node, 16, [];
+}
+
+impl Code {
+    /// The protocol minor version (of major 1) that introduced this code: a host sends a
+    /// node, and a node sends a host, only codes of the minor version they share.
+    pub const fn since_minor(self) -> u8 {
+        match self {
+            Code::ForceLower | Code::ForceUpper | Code::AllForce => 1,
+            _ => 0,
+        }
+    }
 }
 
 /// One half of a node's actuators.
@@ -247,6 +265,39 @@ impl Positions8 {
     pub fn set_half(&mut self, four: &Positions4) {
         let first = four.half.first();
         self.positions[first..first + 4].copy_from_slice(&four.positions);
+    }
+}
+
+/// Measured forces of four actuators, one half of a node (a classic CAN frame's worth;
+/// protocol 1.1). `None` is "not measured" (an actuator without a force sensor).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Forces4 {
+    /// Which four actuators.
+    pub half: Half,
+    /// Their forces, lowest index first.
+    pub forces: [Option<Force>; 4],
+}
+
+/// Measured forces of all eight actuators of a node (protocol 1.1). `None` as in
+/// [`Forces4`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Forces8 {
+    /// Forces of actuators 0..=7.
+    pub forces: [Option<Force>; MAX_ACTUATORS],
+}
+
+impl Forces8 {
+    /// The four forces of one half.
+    pub fn half(&self, half: Half) -> Forces4 {
+        let mut forces = [None; 4];
+        forces.copy_from_slice(&self.forces[half.first()..half.first() + 4]);
+        Forces4 { half, forces }
+    }
+
+    /// Overwrites one half with `four`'s forces (to merge the two classic frames).
+    pub fn set_half(&mut self, four: &Forces4) {
+        let first = four.half.first();
+        self.forces[first..first + 4].copy_from_slice(&four.forces);
     }
 }
 
@@ -401,6 +452,10 @@ pub enum Message {
     ParamValue(Param),
     /// The outcome of a request.
     Ack(Ack),
+    /// Measured forces of one half of a node's actuators (protocol 1.1).
+    Force(Forces4),
+    /// Measured forces of all of a node's actuators (16 bytes: CAN FD or serial; 1.1).
+    AllForce(Forces8),
 }
 
 impl Message {
@@ -428,6 +483,9 @@ impl Message {
             Self::ParamWrite(_) => Code::ParamWrite,
             Self::ParamValue(_) => Code::ParamValue,
             Self::Ack(_) => Code::Ack,
+            Self::Force(Forces4 { half: Half::Lower, .. }) => Code::ForceLower,
+            Self::Force(Forces4 { half: Half::Upper, .. }) => Code::ForceUpper,
+            Self::AllForce(_) => Code::AllForce,
         }
     }
 

@@ -17,7 +17,8 @@ impl ParamId {
     /// Node: watchdog timeout in ms, 10..=60000; default
     /// [`WATCHDOG_TIMEOUT_MS`](crate::timing::WATCHDOG_TIMEOUT_MS).
     pub const WATCHDOG_TIMEOUT: Self = Self(0x0002);
-    /// Node: period of cyclic position feedback in ms (0 = only when polled); default
+    /// Node: period of cyclic position feedback (and, to a 1.1 host, forces) in ms (0 = only
+    /// when polled); default
     /// [`FEEDBACK_PERIOD_MS`](crate::timing::FEEDBACK_PERIOD_MS).
     pub const FEEDBACK_PERIOD: Self = Self(0x0003);
     /// Actuator, read-only: stroke in 0.01 mm.
@@ -36,9 +37,14 @@ impl ParamId {
     pub const FOLLOWING_ERROR_LIMIT: Self = Self(0x0105);
     /// Actuator: homing speed in 0.01 mm/s; default 500.
     pub const HOMING_SPEED: Self = Self(0x0106);
+    /// Actuator (protocol 1.1): the force that stalls the actuator and latches
+    /// `OVER_FORCE`, in 0.01 N, 1..=the rated force; default the rated force.
+    pub const FORCE_LIMIT: Self = Self(0x0107);
+    /// Actuator, read-only (protocol 1.1): the rated force of its drive and sensor, 0.01 N.
+    pub const RATED_FORCE: Self = Self(0x0108);
 
     /// The ids this version defines, with their names.
-    pub const KNOWN: [(Self, &'static str); 10] = [
+    pub const KNOWN: [(Self, &'static str); 12] = [
         (Self::HEARTBEAT_PERIOD, "HeartbeatPeriod"),
         (Self::WATCHDOG_TIMEOUT, "WatchdogTimeout"),
         (Self::FEEDBACK_PERIOD, "FeedbackPeriod"),
@@ -49,7 +55,18 @@ impl ParamId {
         (Self::MAX_ACCEL, "MaxAccel"),
         (Self::FOLLOWING_ERROR_LIMIT, "FollowingErrorLimit"),
         (Self::HOMING_SPEED, "HomingSpeed"),
+        (Self::FORCE_LIMIT, "ForceLimit"),
+        (Self::RATED_FORCE, "RatedForce"),
     ];
+
+    /// The protocol minor version (of major 1) that introduced this parameter: a host
+    /// reads and writes only parameters of the minor version it shares with the node.
+    pub const fn since_minor(self) -> u8 {
+        match self {
+            Self::FORCE_LIMIT | Self::RATED_FORCE => 1,
+            _ => 0,
+        }
+    }
 
     /// Whether the parameter belongs to one actuator (ids `0x0100..=0x01FF`) rather than
     /// to the node.

@@ -24,6 +24,8 @@
 //! |   17 | ParamRead                |   3 | 0–1 param id `u16`, 2 act                                      |
 //! | 18/19| ParamWrite/ParamValue    |   7 | 0–1 param id `u16`, 2 act, 3–6 value `i32`                     |
 //! |   20 | Ack                      |   2 | 0 request code, 1 status                                       |
+//! |21/22 | ForceLower/Upper (1.1)   |   8 | 0–7 four force `i16` 0.01 N (actuators 0–3 / 4–7), `0x8000` = none |
+//! |   23 | AllForce (1.1)           |  16 | 0–15 eight force `i16` (actuators 0–7)                         |
 //!
 //! Decoding rules (the safety net both sides rely on): a payload shorter than its layout is
 //! rejected ([`Error::Truncated`]); bytes past the layout are ignored (a newer minor version
@@ -32,18 +34,18 @@
 
 use crate::Error;
 use crate::actuator::{
-    Accel, ActuatorSet, Position, Speed, actuator_from_wire, actuator_to_wire, position_from_wire,
-    position_to_wire,
+    Accel, ActuatorSet, Force, Position, Speed, actuator_from_wire, actuator_to_wire,
+    force_to_wire, position_from_wire, position_to_wire,
 };
 use crate::drive::{AckStatus, DriveCommand, DriveState, EmergencyCode, Faults};
 use crate::message::{
-    Ack, Capabilities, Code, Emergency, Half, Heartbeat, HostHeartbeat, Identity, Message,
-    MotionLimits, Param, ParamRead, Positions4, Positions8, Sync,
+    Ack, Capabilities, Code, Emergency, Forces4, Forces8, Half, Heartbeat, HostHeartbeat, Identity,
+    Message, MotionLimits, Param, ParamRead, Positions4, Positions8, Sync,
 };
 use crate::param::ParamId;
 use crate::version::{FirmwareVersion, ProtocolVersion};
 
-/// The longest payload of this version (`AllTargets`, `AllFeedback`).
+/// The longest payload of this version (`AllTargets`, `AllFeedback`, `AllForce`).
 pub const MAX_LEN: usize = 16;
 
 /// An encoded payload: at most [`MAX_LEN`] bytes, no allocation.
@@ -80,6 +82,12 @@ impl Payload {
     fn positions(&mut self, positions: &[Option<Position>]) {
         for &p in positions {
             self.u16(position_to_wire(p));
+        }
+    }
+
+    fn forces(&mut self, forces: &[Option<Force>]) {
+        for &f in forces {
+            self.put(&force_to_wire(f).to_le_bytes());
         }
     }
 }
@@ -138,6 +146,8 @@ pub fn encode(message: &Message) -> Payload {
             out.u8(m.request as u8);
             out.u8(m.status as u8);
         }
+        Message::Force(m) => out.forces(&m.forces),
+        Message::AllForce(m) => out.forces(&m.forces),
     }
     out
 }
@@ -178,6 +188,14 @@ impl Reader<'_> {
             *p = position_from_wire(self.u16()?);
         }
         Ok(positions)
+    }
+
+    fn forces<const N: usize>(&mut self) -> Result<[Option<Force>; N], Error> {
+        let mut forces = [None; N];
+        for f in &mut forces {
+            *f = Force::new(self.take().map(i16::from_le_bytes)?);
+        }
+        Ok(forces)
     }
 
     fn protocol(&mut self) -> Result<ProtocolVersion, Error> {
@@ -252,6 +270,9 @@ pub fn decode(code: Code, payload: &[u8]) -> Result<Message, Error> {
             request: Code::from_u8(r.u8()?).ok_or(Error::InvalidField("request"))?,
             status: AckStatus::from_u8(r.u8()?).ok_or(Error::InvalidField("status"))?,
         }),
+        Code::ForceLower => Message::Force(Forces4 { half: Half::Lower, forces: r.forces()? }),
+        Code::ForceUpper => Message::Force(Forces4 { half: Half::Upper, forces: r.forces()? }),
+        Code::AllForce => Message::AllForce(Forces8 { forces: r.forces()? }),
     })
 }
 
@@ -298,6 +319,16 @@ mod tests {
     }
 
     #[test]
+    fn force_layout_is_signed_hundredths_of_a_newton_with_0x8000_for_none() {
+        let m = Message::Force(Forces4 {
+            half: Half::Upper,
+            forces: [Force::new(1234), None, Force::new(-2), Some(Force::ZERO)],
+        });
+        assert_eq!(encode(&m).as_slice(), [0xD2, 0x04, 0x00, 0x80, 0xFE, 0xFF, 0, 0]);
+        assert_eq!(decode(Code::ForceUpper, encode(&m).as_slice()), Ok(m));
+    }
+
+    #[test]
     fn short_payloads_are_truncated_long_ones_accepted() {
         assert_eq!(decode(Code::Sync, &[1]), Err(Error::Truncated));
         assert_eq!(decode(Code::Sync, &[1, 2, 3]), Ok(Message::Sync(Sync { duration_ms: 0x0201 })));
@@ -308,7 +339,7 @@ mod tests {
         assert_eq!(decode(Code::Heartbeat, &[4, 0, 0, 0, 0, 0]), Err(Error::InvalidField("state")));
         assert_eq!(decode(Code::Control, &[9]), Err(Error::InvalidField("command")));
         assert_eq!(decode(Code::Ack, &[1, 99]), Err(Error::InvalidField("status")));
-        assert_eq!(decode(Code::Ack, &[21, 0]), Err(Error::InvalidField("request")));
+        assert_eq!(decode(Code::Ack, &[24, 0]), Err(Error::InvalidField("request")));
         assert_eq!(decode(Code::ParamRead, &[1, 0, 8]), Err(Error::InvalidField("actuator")));
         assert_eq!(
             decode(Code::Identity, &[1, 0, 1, 2, 3, 9]),

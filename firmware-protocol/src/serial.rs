@@ -33,8 +33,9 @@
 //! **Who speaks when**: the line is shared and half-duplex, so a node sends only in answer
 //! to a frame addressed to it (never to a broadcast), starting within
 //! [`SERIAL_REPLY_WITHIN_MS`](crate::timing::SERIAL_REPLY_WITHIN_MS). An addressed
-//! `HostHeartbeat` is the poll: the node answers `Heartbeat`, `AllFeedback`, then any
-//! pending `Emergency` events, oldest first.
+//! `HostHeartbeat` is the poll: the node answers `Heartbeat`, `AllFeedback`, then
+//! `AllForce` if the poll announces protocol 1.1 or later, then any pending `Emergency`
+//! events, oldest first.
 
 use crate::Error;
 use crate::message::{Address, Code, Packet};

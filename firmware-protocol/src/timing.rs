@@ -5,7 +5,8 @@
 //!   periods) while Enabled or Homing stops its actuators and latches `HOST_TIMEOUT`
 //!   (the CANopen consumer heartbeat, the ODrive axis watchdog).
 //! * On CAN, a node sends `Heartbeat` every [`HEARTBEAT_PERIOD_MS`] and its positions every
-//!   [`FEEDBACK_PERIOD_MS`]; the host declares a node lost after [`NODE_LOST_AFTER_MS`]
+//!   [`FEEDBACK_PERIOD_MS`], each time followed by its forces if its host announced protocol
+//!   1.1 or later; the host declares a node lost after [`NODE_LOST_AFTER_MS`]
 //!   without its heartbeat.
 //! * On a serial line nodes speak only when asked: the host polls each node with an
 //!   addressed `HostHeartbeat` every [`FEEDBACK_PERIOD_MS`] (which also feeds its watchdog);
@@ -21,7 +22,8 @@ pub const HOST_HEARTBEAT_PERIOD_MS: u16 = 100;
 pub const WATCHDOG_TIMEOUT_MS: u16 = 300;
 /// Node heartbeat period on CAN (ms).
 pub const HEARTBEAT_PERIOD_MS: u16 = 100;
-/// Position feedback period on CAN, and the poll period on serial (ms).
+/// Position (and, to a 1.1 host, force) feedback period on CAN, and the poll period on
+/// serial (ms).
 pub const FEEDBACK_PERIOD_MS: u16 = 20;
 /// The host declares a node lost after this long without a heartbeat (ms).
 pub const NODE_LOST_AFTER_MS: u16 = 300;

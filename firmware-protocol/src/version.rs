@@ -13,7 +13,10 @@
 //! heartbeat. See [`ProtocolVersion::compatibility`].
 
 /// The protocol version this crate implements.
-pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 0 };
+pub const PROTOCOL_VERSION: ProtocolVersion = ProtocolVersion { major: 1, minor: 1 };
+
+/// Protocol 1.0: positions, the drive state machine and parameters, without force.
+pub const PROTOCOL_1_0: ProtocolVersion = ProtocolVersion { major: 1, minor: 0 };
 
 /// A protocol version, `major.minor`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -40,6 +43,12 @@ pub enum Compatibility {
 }
 
 impl ProtocolVersion {
+    /// Whether a peer of this version measures and reports forces (`Force`, `AllForce`,
+    /// `ForceLimit`, `OVER_FORCE`): since 1.1.
+    pub const fn has_force(self) -> bool {
+        self.major > 1 || (self.major == 1 && self.minor >= 1)
+    }
+
     /// How `self` (say, the host) may talk to a peer speaking `peer`.
     pub const fn compatibility(self, peer: ProtocolVersion) -> Compatibility {
         if self.major != peer.major {
@@ -77,6 +86,12 @@ mod tests {
         assert_eq!(v(1, 3).compatibility(v(1, 1)), Compatibility::Compatible { common_minor: 1 });
         assert_eq!(v(1, 1).compatibility(v(1, 3)), Compatibility::Compatible { common_minor: 1 });
         assert_eq!(v(1, 0).compatibility(v(1, 0)), Compatibility::Compatible { common_minor: 0 });
+    }
+
+    #[test]
+    fn force_arrived_in_1_1() {
+        assert!(!PROTOCOL_1_0.has_force());
+        assert!(PROTOCOL_VERSION.has_force() && v(1, 4).has_force());
     }
 
     #[test]

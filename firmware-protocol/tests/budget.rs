@@ -1,6 +1,7 @@
 //! The bus budget of the README: a full-form update of the reference form (64 panel
 //! actuators on 8 nodes and 8 lifts on a ninth) uses the fewest frames the README claims, and
-//! the README's table is what the encoder and the timing formulas give.
+//! the README's table is what the encoder and the timing formulas give, with the cyclic
+//! traffic a node sends a host of this version (feedback, forces and heartbeats).
 
 use std::path::Path;
 
@@ -10,7 +11,10 @@ use firmware_protocol::timing::{
     FEEDBACK_PERIOD_MS, HEARTBEAT_PERIOD_MS, HOST_HEARTBEAT_PERIOD_MS,
 };
 use firmware_protocol::update::{self, NodeTargets};
-use firmware_protocol::{Code, Link, NodeId, Packet, Position, can, serial};
+use firmware_protocol::version::PROTOCOL_1_0;
+use firmware_protocol::{
+    Code, Link, NodeId, PROTOCOL_VERSION, Packet, Position, ProtocolVersion, can, serial,
+};
 use proptest::prelude::*;
 
 const NODES: u8 = 9;
@@ -93,40 +97,64 @@ fn time_ns(bus: Bus, packets: impl IntoIterator<Item = Packet>) -> u64 {
     packets.into_iter().map(|p| bus.frame_time_ns(p.message.code().payload_len())).sum()
 }
 
-/// Bus time (ns) per second of the cyclic traffic at the default periods.
-fn cyclic_ns_per_s(bus: Bus) -> u64 {
+/// Bus time (ns) per second of the cyclic traffic at the default periods, with a host of
+/// protocol `host`: a node sends its forces (1.1) alongside its feedback, in the same period
+/// and the same shape (two halves on classic CAN, one 16-byte frame on CAN FD and serial),
+/// only to a host that announces force.
+fn cyclic_ns_per_s(bus: Bus, host: ProtocolVersion) -> u64 {
     let per_s = |period_ms: u16| 1000 / u64::from(period_ms);
     let nodes = u64::from(NODES);
-    let len = |code: Code| code.payload_len();
+    let time = |code: Code| bus.frame_time_ns(code.payload_len());
+    let mut per_feedback = match bus.link() {
+        Link::ClassicCan => vec![Code::FeedbackLower, Code::FeedbackUpper],
+        Link::CanFd => vec![Code::AllFeedback],
+        // Each node is polled every feedback period: the poll and its answers.
+        Link::Serial => vec![Code::HostHeartbeat, Code::Heartbeat, Code::AllFeedback],
+    };
+    if host.has_force() {
+        per_feedback.extend(match bus.link() {
+            Link::ClassicCan => vec![Code::ForceLower, Code::ForceUpper],
+            Link::CanFd | Link::Serial => vec![Code::AllForce],
+        });
+    }
+    let cyclic =
+        nodes * per_s(FEEDBACK_PERIOD_MS) * per_feedback.into_iter().map(time).sum::<u64>();
     match bus.link() {
         Link::ClassicCan | Link::CanFd => {
-            let feedback = match bus.link() {
-                Link::ClassicCan => 2 * bus.frame_time_ns(len(Code::FeedbackLower)),
-                _ => bus.frame_time_ns(len(Code::AllFeedback)),
-            };
-            nodes * per_s(FEEDBACK_PERIOD_MS) * feedback
-                + nodes * per_s(HEARTBEAT_PERIOD_MS) * bus.frame_time_ns(len(Code::Heartbeat))
-                + per_s(HOST_HEARTBEAT_PERIOD_MS) * bus.frame_time_ns(len(Code::HostHeartbeat))
+            cyclic
+                + nodes * per_s(HEARTBEAT_PERIOD_MS) * time(Code::Heartbeat)
+                + per_s(HOST_HEARTBEAT_PERIOD_MS) * time(Code::HostHeartbeat)
         }
-        // Each node is polled every feedback period: the poll and its two answers.
-        Link::Serial => {
-            let poll = [Code::HostHeartbeat, Code::Heartbeat, Code::AllFeedback];
-            nodes
-                * per_s(FEEDBACK_PERIOD_MS)
-                * poll.iter().map(|&c| bus.frame_time_ns(len(c))).sum::<u64>()
-        }
+        Link::Serial => cyclic,
+    }
+}
+
+#[test]
+fn forces_load_the_bus_only_for_a_host_that_has_them() {
+    for (name, bus) in BUSES {
+        let (old, new) =
+            (cyclic_ns_per_s(bus, PROTOCOL_1_0), cyclic_ns_per_s(bus, PROTOCOL_VERSION));
+        // One more frame of the feedback's length per feedback frame (the serial poll and
+        // heartbeat aside): AllForce and AllFeedback, ForceLower and FeedbackLower, ... are
+        // each the same length.
+        let feedback = match bus.link() {
+            Link::ClassicCan => 2 * bus.frame_time_ns(Code::FeedbackLower.payload_len()),
+            _ => bus.frame_time_ns(Code::AllFeedback.payload_len()),
+        };
+        let per_s = 1000 / u64::from(FEEDBACK_PERIOD_MS);
+        assert_eq!(new - old, u64::from(NODES) * per_s * feedback, "{name}");
     }
 }
 
 fn budget_table() -> String {
     let mut table = String::from(
         "| link | frames per update | bus time per update | updates/s, bus otherwise idle | \
-         load at 50 updates/s with feedback and heartbeats |\n|---|--:|--:|--:|--:|\n",
+         load at 50 updates/s with feedback, forces and heartbeats |\n|---|--:|--:|--:|--:|\n",
     );
     for (name, bus) in BUSES {
         let packets = update(bus.link());
         let update_ns = time_ns(bus, packets.iter().copied());
-        let load = (update_ns * UPDATE_HZ + cyclic_ns_per_s(bus)) as f64 / 1e9;
+        let load = (update_ns * UPDATE_HZ + cyclic_ns_per_s(bus, PROTOCOL_VERSION)) as f64 / 1e9;
         table += &format!(
             "| {name} | {} | {:.1} µs | {} | {:.1} % |\n",
             packets.len(),
@@ -152,7 +180,7 @@ fn the_readme_budget_table_is_what_the_formulas_give() {
         assert!(
             readme[start..end] == table,
             "README.md's budget table is out of date; it should read\n{table}\nregenerate it \
-             with DRESSFORM_BLESS=1 cargo test -p firmware-protocol --test budget"
+             with DRESSFORM_BLESS=1 cargo test -p firmware-protocol --test main budget"
         );
     }
 }

@@ -26,7 +26,7 @@ fn the_committed_dbc_is_the_generated_one() {
     assert!(
         committed == generated,
         "{} is out of date with the Rust types; regenerate it with\n  \
-         DRESSFORM_BLESS=1 cargo test -p firmware-protocol --test dbc\n\
+         DRESSFORM_BLESS=1 cargo test -p firmware-protocol --test main dbc\n\
          (or: cargo run -p firmware-protocol --example dbc > firmware-protocol/{COMMITTED})",
         path.display()
     );

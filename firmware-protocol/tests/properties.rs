@@ -4,10 +4,26 @@
 use crate::strategies;
 
 use embedded_can::{ExtendedId, Frame as _, Id, StandardId};
-use firmware_protocol::{Error, can, serial};
+use firmware_protocol::{Code, Error, can, serial};
 use proptest::collection::vec;
 use proptest::prelude::*;
+use proptest::strategy::ValueTree;
+use proptest::test_runner::TestRunner;
 use strategies::packet;
+
+/// The properties below hold for every message only if the strategy makes every kind: a
+/// new code (as the forces of 1.1) must be added to it.
+#[test]
+fn the_packet_strategy_makes_every_code() {
+    let mut runner = TestRunner::deterministic();
+    let strategy = packet(1..=63);
+    let codes: Vec<Code> = (0..2000)
+        .map(|_| strategy.new_tree(&mut runner).unwrap().current().message.code())
+        .collect();
+    for code in Code::ALL {
+        assert!(codes.contains(&code), "the strategy makes no {code:?}");
+    }
+}
 
 /// Any frame a CAN driver may hand over: either id kind, remote or not, 0..=64 bytes.
 #[derive(Clone, Debug)]

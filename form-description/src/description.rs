@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 use std::ops::Deref;
 
-use firmware_protocol::{Accel, Actuator, NodeId, Position, Speed};
+use firmware_protocol::{Accel, Actuator, Force, NodeId, Position, Speed};
 use serde::{Deserialize, Serialize};
 
 /// A robotic dress form that passed validation: its nodes, the rings its actuators sit on,
@@ -173,6 +173,10 @@ pub struct ActuatorSpec {
     pub max_speed_mm_s: f64,
     /// Acceleration (and deceleration) limit, mm/s².
     pub max_accel_mm_s2: f64,
+    /// The force that stalls it (its node latches `OVER_FORCE`), N; default
+    /// [`DEFAULT_FORCE_LIMIT_N`]. Nodes of protocol 1.1 measure force.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force_limit_n: Option<f64>,
     /// Id of its mirror partner (a left actuator names its right partner).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mirror: Option<String>,
@@ -199,6 +203,9 @@ pub struct LiftSpec {
     pub max_speed_mm_s: f64,
     /// Acceleration (and deceleration) limit, mm/s².
     pub max_accel_mm_s2: f64,
+    /// The force that stalls it, N; default [`DEFAULT_FORCE_LIMIT_N`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force_limit_n: Option<f64>,
     /// Id of its mirror partner, for a lift raising rings on one side only (a left thigh's
     /// names the right thigh's); a lift raising both sides alike is its own mirror.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -221,7 +228,16 @@ pub struct Axis<'a> {
     pub max_speed_mm_s: f64,
     /// Acceleration (and deceleration) limit, mm/s².
     pub max_accel_mm_s2: f64,
+    /// The force that stalls it, N (the description's, or [`DEFAULT_FORCE_LIMIT_N`]).
+    pub force_limit_n: f64,
 }
+
+/// The force limit of an actuator or lift whose description gives none, N. A safety margin
+/// on both sides: twice the 25 N a panel of the reference form carries under a firm
+/// compression garment (4 kPa over an 80 × 80 mm panel), and under half of the 110 N that
+/// ISO/TS 15066 (Table A.2) allows as a quasi-static contact force on the abdomen, the
+/// lowest of the torso's limits, so a panel pushing on a person stops well before it hurts.
+pub const DEFAULT_FORCE_LIMIT_N: f64 = 50.0;
 
 impl<'a> From<&'a ActuatorSpec> for Axis<'a> {
     fn from(a: &'a ActuatorSpec) -> Self {
@@ -232,6 +248,7 @@ impl<'a> From<&'a ActuatorSpec> for Axis<'a> {
             stroke_mm: a.stroke_mm,
             max_speed_mm_s: a.max_speed_mm_s,
             max_accel_mm_s2: a.max_accel_mm_s2,
+            force_limit_n: a.force_limit_n.unwrap_or(DEFAULT_FORCE_LIMIT_N),
         }
     }
 }
@@ -245,6 +262,7 @@ impl<'a> From<&'a LiftSpec> for Axis<'a> {
             stroke_mm: l.stroke_mm,
             max_speed_mm_s: l.max_speed_mm_s,
             max_accel_mm_s2: l.max_accel_mm_s2,
+            force_limit_n: l.force_limit_n.unwrap_or(DEFAULT_FORCE_LIMIT_N),
         }
     }
 }
@@ -263,6 +281,11 @@ impl Axis<'_> {
     /// The acceleration limit in the protocol's unit (validation keeps it in range).
     pub fn max_accel(&self) -> Accel {
         Accel::from_mm_s2(self.max_accel_mm_s2).unwrap_or_default()
+    }
+
+    /// The force limit in the protocol's unit (validation keeps it in range).
+    pub fn force_limit(&self) -> Force {
+        Force::from_n(self.force_limit_n).unwrap_or(Force::ZERO)
     }
 
     /// Its node's id, if the address is valid.

@@ -7,6 +7,8 @@
 //! neck to mid-thigh, and 8 lifts on a ninth); [`builtin()`] also gives `male`
 //! (`forms/male.toml`). The host (`dressform`: fitting, set-points, the controller) and the
 //! simulator (`form-sim`) both read descriptions from here; this crate knows nothing of either.
+//! Beside the form: [`skin`] (the skin over a ring, its girth and each panel's share) and
+//! [`garment`] (a garment put on the form, for fit tests).
 //!
 //! ```toml
 //! name = "reference"
@@ -34,6 +36,7 @@
 //! stroke_mm = 60.0       # travel outwards from the retracted position
 //! max_speed_mm_s = 12.0
 //! max_accel_mm_s2 = 50.0
+//! # force_limit_n = 50.0 # optional: the force that stalls it (default 50 N)
 //! mirror = "chest-r1"    # left actuators name their right partner
 //!
 //! [[lift]]               # optional: a height axis
@@ -92,11 +95,14 @@
 
 mod description;
 mod file;
+pub mod garment;
 mod number;
+pub mod skin;
 mod validate;
 
 pub use description::{
-    ActuatorSpec, Anchor, Axis, BodyPart, FormDescription, FormSpec, LiftSpec, NodeSpec, RingSpec,
+    ActuatorSpec, Anchor, Axis, BodyPart, DEFAULT_FORCE_LIMIT_N, FormDescription, FormSpec,
+    LiftSpec, NodeSpec, RingSpec,
 };
 pub use file::{BUILTIN, FormError, MALE_TOML, REFERENCE_TOML, builtin, builtin_toml, reference};
 pub use number::{Number, number};

@@ -4,7 +4,9 @@ use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::fmt;
 
 use firmware_protocol::actuator::MAX_ACTUATORS;
-use firmware_protocol::{HUNDREDTHS_PER_MM, NodeId, Position, TENTHS_PER_MM_S2};
+use firmware_protocol::{
+    Force, HUNDREDTHS_PER_MM, HUNDREDTHS_PER_N, NodeId, Position, TENTHS_PER_MM_S2,
+};
 
 use super::description::{ActuatorSpec, Axis, BodyPart, FormDescription, FormSpec, RingSpec};
 use super::number::number;
@@ -19,6 +21,8 @@ const MIN_ACCEL_MM_S2: f64 = 1.0 / TENTHS_PER_MM_S2;
 const MAX_SPEED_MM_S: f64 = 655.35;
 /// Largest acceleration the wire carries (`u16` in 0.1 mm/s²), mm/s².
 const MAX_ACCEL_MM_S2: f64 = 6553.5;
+/// Smallest force limit the wire carries above zero (0.01 N), N.
+const MIN_FORCE_N: f64 = 1.0 / HUNDREDTHS_PER_N;
 /// Tolerance when comparing mirrored quantities (mm, degrees).
 const MIRROR_TOLERANCE: f64 = 1e-6;
 /// The least vertical distance between two rings at any extension of the lifts, mm: a
@@ -420,7 +424,8 @@ impl FormSpec {
             });
         }
         let max_stroke = Position::MAX.mm();
-        let checks: [(&'static str, f64, bool, &'static str); 3] = [
+        let max_force = Force::MAX.n();
+        let checks: [(&'static str, f64, bool, &'static str); 4] = [
             (
                 "stroke_mm",
                 a.stroke_mm,
@@ -438,6 +443,12 @@ impl FormSpec {
                 a.max_accel_mm_s2,
                 a.max_accel_mm_s2 >= MIN_ACCEL_MM_S2 && a.max_accel_mm_s2 <= MAX_ACCEL_MM_S2,
                 "in 0.1..=6553.5",
+            ),
+            (
+                "force_limit_n",
+                a.force_limit_n,
+                a.force_limit_n >= MIN_FORCE_N && a.force_limit_n <= max_force,
+                "in 0.01..=327.67",
             ),
         ];
         push_values(a.id, checks, problems);
@@ -565,6 +576,11 @@ impl FormSpec {
                 ("stroke_mm", lift.stroke_mm, partner.stroke_mm),
                 ("max_speed_mm_s", lift.max_speed_mm_s, partner.max_speed_mm_s),
                 ("max_accel_mm_s2", lift.max_accel_mm_s2, partner.max_accel_mm_s2),
+                (
+                    "force_limit_n",
+                    Axis::from(lift).force_limit_n,
+                    Axis::from(partner).force_limit_n,
+                ),
             ];
             if let Some((field, x, y)) = limits.iter().find(|(_, x, y)| !close(*x, *y)) {
                 problem(format!(
@@ -644,6 +660,7 @@ impl FormSpec {
             ("stroke_mm", a.stroke_mm, b.stroke_mm),
             ("max_speed_mm_s", a.max_speed_mm_s, b.max_speed_mm_s),
             ("max_accel_mm_s2", a.max_accel_mm_s2, b.max_accel_mm_s2),
+            ("force_limit_n", Axis::from(a).force_limit_n, Axis::from(b).force_limit_n),
             ("base_radius_mm", a.base_radius_mm, b.base_radius_mm),
             ("panel_width_mm", a.panel_width_mm, b.panel_width_mm),
         ];

@@ -22,6 +22,7 @@ use dressform::messages;
 use firmware_protocol::Position;
 use firmware_protocol::message::Sync;
 use form_description::FormDescription;
+use form_description::garment::GarmentSpec;
 use std::ops::Bound;
 
 use super::link::{self, FormArg, LinkArgs, runtime};
@@ -162,6 +163,22 @@ pub fn execute<R: Send + 'static>(
     json: bool,
     compute: impl FnOnce() -> Result<(R, SetPoints), Failure> + Send + 'static,
 ) -> Result<(R, DriveReport), Failure> {
+    let steps = move || compute().map(|(value, setpoints)| (value, vec![setpoints]));
+    let (value, mut reports) = execute_through(form, link, options, sim, None, json, steps)?;
+    Ok((value, reports.remove(0)))
+}
+
+/// [`execute`] through several set-points in turn (one move each, one report each), the
+/// simulated form wearing `garment` (with `--sim`).
+pub fn execute_through<R: Send + 'static>(
+    form: &FormDescription,
+    link: &LinkSpec,
+    options: &DriveOptions,
+    sim: &SimArgs,
+    garment: Option<GarmentSpec>,
+    json: bool,
+    compute: impl FnOnce() -> Result<(R, Vec<SetPoints>), Failure> + Send + 'static,
+) -> Result<(R, Vec<DriveReport>), Failure> {
     if *link != LinkSpec::Sim && (sim.log.is_some() || sim.faults.is_some()) {
         return Err(Failure::bad_input("--log and --faults go with --sim"));
     }
@@ -173,7 +190,8 @@ pub fn execute<R: Send + 'static>(
     let progress = |p: &Progress| display.update(p);
     let runtime = runtime()?;
     let result = runtime.block_on(async {
-        let config = SimConfig { faults, log: sim.log.clone(), ..SimConfig::default() };
+        let config =
+            SimConfig { faults, log: sim.log.clone(), ..SimConfig::default() }.wearing(garment);
         let owned = link::own(link, form, &config)?;
         let rig = owned.rig;
         // The simulated bus's log, watched while the form moves.

@@ -29,6 +29,7 @@ macro_rules! errln {
 mod demo;
 mod drive;
 mod estop;
+mod fit_test;
 mod form;
 mod info;
 mod link;
@@ -94,6 +95,8 @@ enum Command {
     Demo(demo::DemoArgs),
     /// Drive the robotic form to a set-point file, all actuators together, with live progress.
     Drive(drive::DriveArgs),
+    /// Test a garment on the form shaped to a customer: ease and pressure per ring, a sweep.
+    FitTest(fit_test::FitTestArgs),
     /// Show every node of the robotic form: identity, state, faults, positions.
     Status(status::StatusArgs),
     /// Broadcast an emergency stop to every node of the robotic form, from any terminal.
@@ -392,6 +395,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         Command::Sim(a) => sim::run(&a),
         Command::Demo(a) => demo::run(&a),
         Command::Drive(a) => drive::run(&a),
+        Command::FitTest(a) => fit_test::run(&a),
         Command::Status(a) => status::run(&a),
         Command::Estop(a) => estop::run(&a),
         Command::Model(a) => model::run(&a),

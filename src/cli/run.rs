@@ -6,20 +6,22 @@
 //! scan's, the pose-symmetric scan's, the mannequin's and the form's girths at every ring.
 //! Exit status 3 when a ring did not reach the mannequin's girth.
 
-use super::drive::{ShapeArgs, SimArgs, execute, shape_verdict};
+use super::drive::{ShapeArgs, SimArgs, execute_through, shape_verdict};
 use super::link::{FormArg, LinkArgs};
 use super::setpoints::fidelity_table;
 use super::{Failure, FrameArgs, LegArgs, SmoothArgs, print_warnings, progress_bar};
 use dressform::atomic_output::OutputSet;
 use dressform::body::scan::{self, Scan, ScanOptions, format::Export, format::Format};
-use dressform::form::controller::{DriveOptions, LinkSpec};
+use dressform::form::controller::{DriveOptions, DriveReport, LinkSpec};
 use dressform::form::form_fit::{ShapeOutcome, Targets, Tolerance, compare};
+use dressform::form::setpoints::SetPoints;
 use dressform::pose::body_model::BodyModel;
 use dressform::pose::model_fit::verdict::RegionResidual;
 use dressform::run::outputs::Outputs;
 use dressform::run::pipeline::SHAPE_STEPS;
 use dressform::run::reconstruct::{ReconstructOptions, Reshaped, STEPS, reconstruct_shape};
 use form_description::FormDescription;
+use form_description::garment::GarmentSpec;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]
@@ -122,6 +124,38 @@ pub fn shape_form<X: Send + 'static>(
     out: &Path,
     prepare: impl FnOnce() -> Result<Prepared<X>, Failure> + Send + 'static,
 ) -> Result<(Reshaped, ShapeOutcome, X), Failure> {
+    let (done, shape, extra, _) = shape_form_through(form, drive, out, prepare, Moves::shape())?;
+    Ok((done, shape, extra))
+}
+
+/// Makes a command's steps from the mannequin's set-points: one move each.
+pub type StepsOf = Box<dyn FnOnce(&SetPoints) -> Vec<SetPoints> + Send>;
+
+/// What the form is driven through once the mannequin's set-points are known.
+pub struct Moves {
+    /// The steps, made from the mannequin's set-points.
+    pub steps: StepsOf,
+    /// What the simulated form wears (with `--sim`).
+    pub garment: Option<GarmentSpec>,
+}
+
+impl Moves {
+    /// The mannequin's shape, once (`run`, `demo`).
+    pub fn shape() -> Self {
+        Self { steps: Box::new(|setpoints| vec![setpoints.clone()]), garment: None }
+    }
+}
+
+/// [`shape_form`] through `moves` (the mannequin's set-points first made into steps: a fit
+/// test's sweep), with every step's report; the shape is judged at the step that is the
+/// mannequin's set-points (else the first).
+pub fn shape_form_through<X: Send + 'static>(
+    form: &FormDescription,
+    drive: &Drive,
+    out: &Path,
+    prepare: impl FnOnce() -> Result<Prepared<X>, Failure> + Send + 'static,
+    moves: Moves,
+) -> Result<(Reshaped, ShapeOutcome, X, Vec<DriveReport>), Failure> {
     let (shape_of, out_dir) = (form.clone(), out.to_path_buf());
     let device = match drive.link {
         LinkSpec::Sim => "simulated bus".to_string(),
@@ -139,14 +173,16 @@ pub fn shape_form<X: Send + 'static>(
         errln!("{claimed}");
         let Prepared { scan, reconstruct, outputs, extra } = prepare()?;
         let done = reconstruct_and_write(&scan, &reconstruct, &shape_of, &out_dir, outputs)?;
-        let setpoints = done.shaped.setpoints.clone();
-        Ok(((done, extra), setpoints))
+        let steps = (moves.steps)(&done.shaped.setpoints);
+        let at = steps.iter().position(|s| *s == done.shaped.setpoints).unwrap_or(0);
+        Ok(((done, extra, at), steps))
     };
-    let ((done, extra), report) =
-        execute(form, drive.link, drive.options, drive.sim, false, compute)?;
-    for warning in &report.warnings {
+    let ((done, extra, at), reports) =
+        execute_through(form, drive.link, drive.options, drive.sim, moves.garment, false, compute)?;
+    for warning in reports.iter().flat_map(|r| &r.warnings) {
         errln!("warning: {warning}");
     }
+    let report = &reports[at];
     let setpoints = &done.shaped.setpoints;
     let targets = Targets {
         girths_mm: &setpoints.target_girths_mm,
@@ -167,7 +203,7 @@ pub fn shape_form<X: Send + 'static>(
     );
     outln!();
     out!("{}", girth_table(&done, &shape));
-    Ok((done, shape, extra))
+    Ok((done, shape, extra, reports))
 }
 
 /// Pose symmetry, mannequin and set-points of `scan`, committed into `out` with the files

@@ -4,13 +4,13 @@ use std::ops::RangeInclusive;
 
 use firmware_protocol::drive::{AckStatus, DriveCommand, DriveState, EmergencyCode, Faults};
 use firmware_protocol::message::{
-    Ack, Addressing, Capabilities, Emergency, Half, Heartbeat, HostHeartbeat, Identity,
-    MotionLimits, Param, ParamRead, Positions4, Positions8, Sync,
+    Ack, Addressing, Capabilities, Emergency, Forces4, Forces8, Half, Heartbeat, HostHeartbeat,
+    Identity, MotionLimits, Param, ParamRead, Positions4, Positions8, Sync,
 };
 use firmware_protocol::param::ParamId;
 use firmware_protocol::version::FirmwareVersion;
 use firmware_protocol::{
-    Accel, Actuator, ActuatorSet, Address, Code, Message, NodeId, Packet, Position,
+    Accel, Actuator, ActuatorSet, Address, Code, Force, Message, NodeId, Packet, Position,
     ProtocolVersion, Speed,
 };
 use proptest::prelude::*;
@@ -22,6 +22,16 @@ fn position() -> impl Strategy<Value = Option<Position>> {
         1 => Just(None),
         1 => select(vec![Position::ZERO, Position::MAX]).prop_map(Some),
         4 => (0..=Position::MAX.hundredths_mm()).prop_map(Position::new),
+    ]
+}
+
+fn force() -> impl Strategy<Value = Option<Force>> {
+    // Often "not measured", often the ends of the range and no load, otherwise anything but
+    // the reserved i16::MIN (which is "not measured" on the wire).
+    prop_oneof![
+        1 => Just(None),
+        1 => select(vec![Force::MAX, Force::new(-i16::MAX).unwrap(), Force::ZERO]).prop_map(Some),
+        4 => (-i16::MAX..=i16::MAX).prop_map(Force::new),
     ]
 }
 
@@ -56,6 +66,15 @@ fn four() -> impl Strategy<Value = Positions4> {
 
 fn eight() -> impl Strategy<Value = Positions8> {
     proptest::array::uniform8(position()).prop_map(|positions| Positions8 { positions })
+}
+
+fn forces4() -> impl Strategy<Value = Forces4> {
+    (half(), [force(), force(), force(), force()])
+        .prop_map(|(half, forces)| Forces4 { half, forces })
+}
+
+fn forces8() -> impl Strategy<Value = Forces8> {
+    proptest::array::uniform8(force()).prop_map(|forces| Forces8 { forces })
 }
 
 /// Every valid message, each kind about equally often.
@@ -112,6 +131,8 @@ fn message() -> impl Strategy<Value = Message> {
         param().prop_map(Message::ParamValue),
         (select(Code::ALL.to_vec()), select(AckStatus::ALL.to_vec()))
             .prop_map(|(request, status)| Message::Ack(Ack { request, status })),
+        forces4().prop_map(Message::Force),
+        forces8().prop_map(Message::AllForce),
     ]
 }
 

@@ -1,12 +1,14 @@
 //! The bus load the in-process bus reports matches the budget table of
 //! `firmware-protocol/README.md`: the frames and bus time of a full-form update, and the load
-//! of 50 updates a second with the reference form's cyclic feedback and heartbeats.
+//! of 50 updates a second with the reference form's cyclic feedback, forces and heartbeats
+//! (the test host announces this crate's protocol version, 1.1, so the nodes send it their
+//! forces alongside their feedback).
 
 use crate::test_host;
 
 use firmware_protocol::message::Sync;
 use firmware_protocol::update::{self, NodeTargets};
-use firmware_protocol::{Link, NodeId, Position};
+use firmware_protocol::{Code, Link, NodeId, PROTOCOL_VERSION, Position};
 use form_description::reference;
 use form_sim::bus::can::{CanBus, CanKind};
 use form_sim::fault::FaultSpec;
@@ -95,6 +97,24 @@ async fn fifty_updates_a_second_with_cyclic_traffic_load_the_bus_as_the_readme_s
         }
         let measured = bus.stats().since(&before);
         assert_eq!(measured.elapsed, Duration::from_secs(2));
+        // The README's load counts one force frame per feedback frame (protocol 1.1: same
+        // period, same shape); a mismatch here names the cause before the load does.
+        let window = start..=start + measured.elapsed;
+        let count = |codes: [Code; 3]| {
+            host.received
+                .iter()
+                .filter(|(at, p)| window.contains(at) && codes.contains(&p.message.code()))
+                .count()
+        };
+        let feedback = count([Code::FeedbackLower, Code::FeedbackUpper, Code::AllFeedback]);
+        let forces = count([Code::ForceLower, Code::ForceUpper, Code::AllForce]);
+        let expected = if PROTOCOL_VERSION.has_force() { feedback } else { 0 };
+        assert!(feedback > 0, "{name}: no feedback");
+        // A period's frames may straddle the end of the measurement.
+        assert!(
+            forces.abs_diff(expected) <= 2 * nodes.len(),
+            "{name}: {forces} force frames for {feedback} feedback frames"
+        );
         let load = 100.0 * measured.load();
         assert!(
             (load - row.load_percent).abs() < 0.3,

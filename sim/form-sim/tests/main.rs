@@ -9,6 +9,7 @@ mod bus_budget;
 mod can_bus;
 mod fault_injection;
 mod form_on_can;
+mod garment_on_form;
 mod node_state_machine;
 mod serial_pty;
 mod slcan_pty;

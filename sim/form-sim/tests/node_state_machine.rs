@@ -8,7 +8,7 @@ use firmware_protocol::message::{
 };
 use firmware_protocol::param::ParamId;
 use firmware_protocol::update::shortest_duration_ms;
-use firmware_protocol::version::FirmwareVersion;
+use firmware_protocol::version::{FirmwareVersion, PROTOCOL_1_0};
 use firmware_protocol::{
     Accel, Actuator, ActuatorSet, Code, Link, Message, NodeId, PROTOCOL_VERSION, Packet, Position,
     ProtocolVersion, Speed,
@@ -24,6 +24,7 @@ fn config(link: Link, actuators: usize) -> NodeConfig {
         max_speed: 1000,
         max_accel: 500,
         start_mm: 1.0,
+        rated_force: RATED_FORCE,
     };
     NodeConfig {
         id: ID,
@@ -31,9 +32,14 @@ fn config(link: Link, actuators: usize) -> NodeConfig {
         actuators: vec![actuator; actuators],
         firmware: FirmwareVersion { major: 2, minor: 3, patch: 4 },
         noise_mm: 0.0,
+        force_noise_n: 0.0,
+        protocol: PROTOCOL_VERSION,
         seed: 1,
     }
 }
+
+/// The actuators' rated force in these tests, 0.01 N (80 N).
+const RATED_FORCE: u16 = 8000;
 
 fn actuator(index: u8) -> Actuator {
     Actuator::new(index).unwrap()
@@ -43,8 +49,14 @@ fn to_node(message: Message) -> Packet {
     Packet::node(ID, message)
 }
 
+/// A heartbeat of a host of protocol `major`.0.
 fn heartbeat(major: u8) -> Message {
     Message::HostHeartbeat(HostHeartbeat { protocol: ProtocolVersion { major, minor: 0 } })
+}
+
+/// A heartbeat of a host of this crate's protocol version (1.1: it reads forces).
+fn heartbeat_1_1() -> Message {
+    Message::HostHeartbeat(HostHeartbeat { protocol: PROTOCOL_VERSION })
 }
 
 fn ack(request: Code, status: AckStatus) -> Packet {
@@ -321,7 +333,7 @@ fn parameters_have_the_readme_scopes_and_ranges() {
         (write(ParamId::MAX_SPEED, None, 1001), InvalidArgument),
         (write(ParamId::MAX_SPEED, None, 700), Ok),
         (write(ParamId::SOFT_LIMIT_MIN, Some(actuator(1)), 5001), InvalidArgument),
-        (write(ParamId(0x0107), None, 1), UnknownParameter),
+        (write(ParamId(0x0109), None, 1), UnknownParameter),
     ];
     for (request, status) in cases {
         assert_eq!(bench.send(request), [ack(Code::ParamWrite, status)], "{request:?}");
@@ -429,4 +441,133 @@ fn a_reboot_forgets_everything_but_where_the_panels_are() {
         if h.state == DriveState::Disabled && h.homed.is_empty()));
     let states = bench.node.actuator_states(bench.now);
     assert!(states.iter().all(|a| a.position_mm == 20.0 && !a.homed));
+}
+
+/// Forces (protocol 1.1) go with the feedback only to a host that reads them: on serial the
+/// poll answer is heartbeat, positions, forces; on classic CAN both force halves follow the
+/// feedback halves every 20 ms; a 1.0 host (and any host of a 1.0 node) sees none.
+#[test]
+fn forces_go_with_the_feedback_to_a_host_that_reads_them() {
+    let codes = |sent: &[Packet]| sent.iter().map(|p| p.message.code()).collect::<Vec<_>>();
+    let mut serial = Bench::new(Link::Serial, 8);
+    serial.node.apply_load(actuator(3), 12.5);
+    assert_eq!(codes(&serial.send(to_node(heartbeat(1)))), [Code::Heartbeat, Code::AllFeedback]);
+    let answer = serial.send(to_node(heartbeat_1_1()));
+    assert_eq!(codes(&answer), [Code::Heartbeat, Code::AllFeedback, Code::AllForce]);
+    let Message::AllForce(forces) = answer[2].message else { unreachable!() };
+    assert_eq!(forces.forces[3].map(|f| f.n()), Some(12.5));
+    assert_eq!(forces.forces[0].map(|f| f.n()), Some(0.0));
+
+    let mut can = Bench::new(Link::ClassicCan, 8);
+    can.send(Packet::broadcast(heartbeat_1_1()));
+    can.fed = can.now;
+    let sent = can.run(99);
+    let count = |code| sent.iter().filter(|p| p.message.code() == code).count();
+    assert_eq!((count(Code::ForceLower), count(Code::ForceUpper)), (4, 4), "{:?}", codes(&sent));
+    // `run` feeds a 1.0 heartbeat at 100 ms (after the feedback due then): from then on no
+    // forces.
+    can.run(1);
+    let later = can.run(100);
+    assert!(!later.iter().any(|p| matches!(p.message, Message::Force(_))));
+
+    let mut old = Node::power_on(
+        NodeConfig { protocol: PROTOCOL_1_0, ..config(Link::Serial, 8) },
+        serial.now,
+    );
+    old.receive(serial.now, &to_node(heartbeat_1_1()));
+    assert_eq!(codes(&old.take_outgoing()), [Code::Heartbeat, Code::AllFeedback]);
+}
+
+/// `ForceLimit` defaults to the rated force and takes 1..=rated; `RatedForce` is read-only;
+/// a 1.0 node knows neither.
+#[test]
+fn the_force_limit_is_a_1_1_parameter_up_to_the_rated_force() {
+    let mut bench = Bench::new(Link::Serial, 2);
+    let read = |bench: &mut Bench, param| {
+        bench.send(to_node(Message::ParamRead(ParamRead { param, actuator: Some(actuator(1)) })))
+    };
+    let write = |bench: &mut Bench, value| {
+        bench.send(to_node(Message::ParamWrite(Param {
+            param: ParamId::FORCE_LIMIT,
+            actuator: None,
+            value,
+        })))
+    };
+    let value = |param, value| {
+        vec![to_node_answer(Message::ParamValue(Param {
+            param,
+            actuator: Some(actuator(1)),
+            value,
+        }))]
+    };
+    assert_eq!(read(&mut bench, ParamId::FORCE_LIMIT), value(ParamId::FORCE_LIMIT, 8000));
+    assert_eq!(read(&mut bench, ParamId::RATED_FORCE), value(ParamId::RATED_FORCE, 8000));
+    assert_eq!(write(&mut bench, 2500), [ack(Code::ParamWrite, AckStatus::Ok)]);
+    assert_eq!(read(&mut bench, ParamId::FORCE_LIMIT), value(ParamId::FORCE_LIMIT, 2500));
+    for bad in [0, 8001, -5] {
+        assert_eq!(write(&mut bench, bad), [ack(Code::ParamWrite, AckStatus::InvalidArgument)]);
+    }
+    let rated = bench.send(to_node(Message::ParamWrite(Param {
+        param: ParamId::RATED_FORCE,
+        actuator: None,
+        value: 100,
+    })));
+    assert_eq!(rated, [ack(Code::ParamWrite, AckStatus::ReadOnlyParameter)]);
+
+    let mut old = Bench {
+        node: Node::power_on(
+            NodeConfig { protocol: PROTOCOL_1_0, ..config(Link::Serial, 2) },
+            bench.now,
+        ),
+        ..bench
+    };
+    assert_eq!(write(&mut old, 2500), [ack(Code::ParamWrite, AckStatus::UnknownParameter)]);
+}
+
+fn to_node_answer(message: Message) -> Packet {
+    Packet::node(ID, message)
+}
+
+/// A panel pushing into a load over its force limit stops where it is at once, and the node
+/// latches `OVER_FORCE` naming it with the force; FaultReset clears it (the push stopped). A
+/// 1.0 node, which measures nothing, moves on.
+#[test]
+fn an_actuator_over_its_force_limit_stalls_and_latches_over_force() {
+    let mut bench = Bench::ready(Link::ClassicCan, 8);
+    bench.send(to_node(Message::AllTargets(Positions8 { positions: [Position::new(4000); 8] })));
+    bench.send(Packet::broadcast(Message::Sync(Sync { duration_ms: 0 })));
+    bench.run(500);
+    let before = bench.node.actuator_states(bench.now)[6];
+    assert!(before.moving && before.position_mm > 2.0 && before.position_mm < 38.0, "{before:?}");
+    bench.node.apply_load(actuator(6), 80.5);
+    let sent = bench.run(1);
+    let event = events(&sent)[0];
+    assert_eq!(
+        (event.code, event.actuator, event.detail),
+        (EmergencyCode::OVER_FORCE, Some(actuator(6)), 8050)
+    );
+    assert_eq!((bench.node.state(), bench.node.faults()), (DriveState::Fault, Faults::OVER_FORCE));
+    let stalled = bench.node.actuator_states(bench.now)[6];
+    assert!(
+        !stalled.moving && (stalled.position_mm - before.position_mm).abs() < 0.02,
+        "{stalled:?}"
+    );
+    assert!(stalled.homed, "a stall keeps the home: the encoder is right");
+    bench.run(1000);
+    assert_eq!(bench.node.actuator_states(bench.now)[6].position_mm, stalled.position_mm);
+    let reset = bench.send(to_node(Message::Control(DriveCommand::FaultReset)));
+    assert_eq!(reset.last(), Some(&ack(Code::Control, AckStatus::Ok)));
+
+    let mut old = Bench {
+        node: Node::power_on(
+            NodeConfig { protocol: PROTOCOL_1_0, ..config(Link::ClassicCan, 8) },
+            bench.now,
+        ),
+        ..bench
+    };
+    old.send(to_node(heartbeat(1)));
+    old.send(to_node(Message::Control(DriveCommand::Enable)));
+    old.node.apply_load(actuator(6), 200.0);
+    old.run(50);
+    assert_eq!(old.node.state(), DriveState::Enabled);
 }

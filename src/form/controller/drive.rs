@@ -15,6 +15,7 @@ use tokio::time::Instant;
 
 use super::claim::{Claim, names, newly_stopped};
 use super::faults::{self, ANY_FAULT};
+use super::forces::{self, ForceSample};
 use super::motion::{self, ActuatorReport, MoveError, Progress};
 use super::plan::{Clamped, plan};
 use super::session::{Cleared, Session, SessionError};
@@ -53,6 +54,9 @@ pub struct DriveOptions {
     /// Clear latched hardware faults (a jam, an overcurrent, a broken encoder...) at start;
     /// without it only an emergency stop and a host timeout are cleared (default false).
     pub reset_faults: bool,
+    /// Read every actuator's force at rest after the move, for this long (default: no);
+    /// needs nodes of protocol 1.1, checked before anything moves.
+    pub read_forces: Option<Duration>,
 }
 
 impl Default for DriveOptions {
@@ -65,6 +69,7 @@ impl Default for DriveOptions {
             settle: DEFAULT_SETTLE,
             homing_timeout: DEFAULT_HOMING_TIMEOUT,
             reset_faults: false,
+            read_forces: None,
         }
     }
 }
@@ -90,6 +95,10 @@ pub struct DriveReport {
     /// Faults cleared at the start, warnings from the nodes (a move too short, ...) and
     /// resumed reboots.
     pub warnings: Vec<String>,
+    /// Every actuator's force at rest after the move, by id (with
+    /// [`DriveOptions::read_forces`]; empty otherwise).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub forces: BTreeMap<String, ForceSample>,
 }
 
 impl DriveReport {
@@ -111,6 +120,9 @@ pub enum DriveError {
     /// The move failed.
     #[error(transparent)]
     Move(#[from] MoveError),
+    /// Forces were asked for, but some nodes measure none (protocol 1.0; nothing moved).
+    #[error("node(s) {} speak protocol 1.0 and measure no force: reading forces needs nodes of protocol 1.1 (update their firmware)", crate::messages::list(.0.iter()))]
+    NoForce(Vec<u8>),
     /// Some actuators did not arrive within tolerance in time.
     #[error("{} actuators not within tolerance after {} ms: {}", .0.actuators.iter().filter(|a| !a.within_tolerance).count(), .0.elapsed_ms, crate::messages::list(.0.actuators.iter().filter(|a| !a.within_tolerance).map(|a| &a.id)))]
     NotReached(Box<DriveReport>),
@@ -166,8 +178,8 @@ pub enum DriveAfterError<E> {
     Drive(DriveError),
 }
 
-/// Drives `form` over `transport` to the set-points `compute` returns, with the value it
-/// returns beside them.
+/// Drives `form` over `transport` through the set-points `compute` returns (one move per
+/// step, [`Claim::drive_through`]), with the value it returns beside them.
 ///
 /// The form is claimed before `compute` starts ([`Claim::take`]): every node discovered and
 /// the e-stops latched on it recorded. `compute` then runs on a thread of its own (named, with
@@ -181,10 +193,10 @@ pub async fn drive_after<T, R, E>(
     transport: T,
     form: &FormDescription,
     options: &DriveOptions,
-    compute: impl FnOnce() -> Result<(R, SetPoints), E> + Send + 'static,
+    compute: impl FnOnce() -> Result<(R, Vec<SetPoints>), E> + Send + 'static,
     progress: impl FnMut(&Progress),
     beside: impl Future<Output = ()>,
-) -> Result<(R, DriveReport), DriveAfterError<E>>
+) -> Result<(R, Vec<DriveReport>), DriveAfterError<E>>
 where
     T: Transport,
     R: Send + 'static,
@@ -200,12 +212,12 @@ where
             let _ = computed.send(compute());
         })
         .map_err(|e| DriveAfterError::Thread(ComputeThreadError::Spawn(e)))?;
-    let (value, setpoints) = match claim.hold_while(result).await {
+    let (value, steps) = match claim.hold_while(result).await {
         Ok(Ok(done)) => done.map_err(DriveAfterError::Computation)?,
         Ok(Err(_)) => return Err(DriveAfterError::Thread(ComputeThreadError::NoResult)),
         Err(stopped) => return Err(DriveAfterError::Claim(stopped)),
     };
-    let driving = claim.drive(&setpoints, options, progress);
+    let driving = claim.drive_through(&steps, options, progress);
     tokio::pin!(driving);
     let report = tokio::select! {
         report = &mut driving => report,
@@ -218,16 +230,42 @@ impl<T: Transport> Claim<T> {
     /// Drives the form to `setpoints` (see [`drive()`]): checks them, clears the latched
     /// faults [`DriveOptions::reset_faults`] allows — an e-stop only on a node that held it
     /// when the form was claimed — enables and homes, moves every actuator together, watches
-    /// until all are within tolerance, then disables.
+    /// until all are within tolerance (and reads the forces at rest, if asked), then
+    /// disables.
     pub async fn drive(
         self,
         setpoints: &SetPoints,
         options: &DriveOptions,
-        mut progress: impl FnMut(&Progress),
+        progress: impl FnMut(&Progress),
     ) -> Result<DriveReport, DriveError> {
+        let mut reports =
+            self.drive_through(std::slice::from_ref(setpoints), options, progress).await?;
+        Ok(reports.remove(0))
+    }
+
+    /// Drives the form through `steps` in turn, as [`Claim::drive`] drives it to one: every
+    /// step checked before anything moves, faults cleared and the form enabled once, then for
+    /// each step one synchronised move (and the forces at rest, if asked); disabled at the
+    /// end. The first step not reached ends the sequence with [`DriveError::NotReached`].
+    /// One report per step.
+    pub async fn drive_through(
+        self,
+        steps: &[SetPoints],
+        options: &DriveOptions,
+        mut progress: impl FnMut(&Progress),
+    ) -> Result<Vec<DriveReport>, DriveError> {
         let (mut session, stopped_at_start) = self.into_parts();
         let form = session.form().clone();
-        let (plan, clamped) = plan(&form, setpoints, options.clamp)?;
+        let plans = steps
+            .iter()
+            .map(|setpoints| plan(&form, setpoints, options.clamp))
+            .collect::<Result<Vec<_>, _>>()?;
+        if options.read_forces.is_some() {
+            let missing = forces::without_force(&session);
+            if !missing.is_empty() {
+                return Err(DriveError::NoForce(missing));
+            }
+        }
         let device = session.device();
         let allowed = if options.reset_faults { ANY_FAULT } else { faults::CLEARED_AT_START };
         let allowed_on = |node| {
@@ -264,31 +302,48 @@ impl<T: Transport> Claim<T> {
             min_duration: options.min_duration,
             settle: options.settle,
         };
-        let started = Instant::now();
-        let result =
-            motion::run(&mut session, &plan, &move_options, options.homing_timeout, &mut progress)
-                .await;
-        let (duration_ms, actuators, warnings) = match result {
-            Ok(done) => done,
-            // A session error is the session's, wherever it happened.
-            Err(MoveError::Session(e)) => return Err(e.into()),
-            Err(e) => return Err(e.into()),
-        };
-        notes.extend(warnings);
-        let elapsed_ms = started.elapsed().as_millis() as u64;
-        let positions_mm = positions_of(&session);
+        let mut reports = Vec::with_capacity(plans.len());
+        for (plan, clamped) in plans {
+            let started = Instant::now();
+            let result = motion::run(
+                &mut session,
+                &plan,
+                &move_options,
+                options.homing_timeout,
+                &mut progress,
+            )
+            .await;
+            let (duration_ms, actuators, warnings) = match result {
+                Ok(done) => done,
+                // A session error is the session's, wherever it happened.
+                Err(MoveError::Session(e)) => return Err(e.into()),
+                Err(e) => return Err(e.into()),
+            };
+            notes.extend(warnings);
+            let elapsed_ms = started.elapsed().as_millis() as u64;
+            let forces = match options.read_forces {
+                Some(window) => forces::read_forces(&mut session, window, &mut notes).await?,
+                None => BTreeMap::new(),
+            };
+            let report = DriveReport {
+                form: form.name.clone(),
+                device: device.clone(),
+                duration_ms,
+                elapsed_ms,
+                actuators,
+                positions_mm: positions_of(&session),
+                clamped,
+                warnings: std::mem::take(&mut notes),
+                forces,
+            };
+            if !report.converged() {
+                session.disable_all().await?;
+                return Err(DriveError::NotReached(Box::new(report)));
+            }
+            reports.push(report);
+        }
         session.disable_all().await?;
-        let report = DriveReport {
-            form: form.name.clone(),
-            device,
-            duration_ms,
-            elapsed_ms,
-            actuators,
-            positions_mm,
-            clamped,
-            warnings: notes,
-        };
-        if report.converged() { Ok(report) } else { Err(DriveError::NotReached(Box::new(report))) }
+        Ok(reports)
     }
 }
 

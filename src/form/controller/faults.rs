@@ -10,8 +10,8 @@
 
 use std::fmt;
 
-use firmware_protocol::HUNDREDTHS_PER_MM;
 use firmware_protocol::drive::{AckStatus, DriveState, EmergencyCode, Faults};
+use firmware_protocol::{HUNDREDTHS_PER_MM, HUNDREDTHS_PER_N};
 
 /// Faults a drive clears at start on its own: latched by a stop or by the host, not by the
 /// hardware.
@@ -43,7 +43,7 @@ pub fn fault_names(faults: Faults) -> Vec<String> {
 
 /// What one fault flag means.
 fn flag_words(flag: Faults) -> &'static str {
-    const WORDS: [(Faults, &str); 10] = [
+    const WORDS: [(Faults, &str); 11] = [
         (Faults::EMERGENCY_STOP, "emergency stop"),
         (Faults::HOST_TIMEOUT, "host timeout (the host fell silent)"),
         (Faults::OVERCURRENT, "overcurrent"),
@@ -57,6 +57,11 @@ fn flag_words(flag: Faults) -> &'static str {
         (Faults::LIMIT_SWITCH, "limit switch hit outside homing"),
         (Faults::HOMING_FAILED, "homing failed (no home switch found)"),
         (Faults::INTERNAL, "internal firmware error"),
+        (
+            Faults::OVER_FORCE,
+            "over its force limit (a panel pushed harder than allowed: a garment too tight, \
+             or something in its way)",
+        ),
     ];
     WORDS.iter().find(|(f, _)| *f == flag).map_or("a fault this host does not know", |(_, w)| w)
 }
@@ -101,6 +106,11 @@ pub fn event_words(code: EmergencyCode, detail: i32) -> String {
             format!("homing failed: no home switch after {}", mm(detail))
         }
         EmergencyCode::EMERGENCY_STOP => "emergency stop".into(),
+        EmergencyCode::OVER_FORCE => format!(
+            "over its force limit: it felt {:.2} N and stopped (a garment too tight, or \
+             something in its way)",
+            f64::from(detail) / HUNDREDTHS_PER_N
+        ),
         EmergencyCode::INTERNAL => format!("internal firmware error (detail {detail})"),
         EmergencyCode::TARGET_OUT_OF_RANGE => format!("target {} out of range", mm(detail)),
         EmergencyCode::NOT_HOMED => "target refused: not homed".into(),

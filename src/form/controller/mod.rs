@@ -19,6 +19,7 @@
 //! | [`status`](mod@status) | `dressform status`: every node's state, unchanged |
 //! | [`reset`](mod@reset) | `dressform reset`: latched faults cleared |
 //! | [`faults`] | states, faults, events and refusals in words; which faults the host clears |
+//! | [`forces`] | what the form feels at rest (protocol 1.1): every actuator's force, averaged |
 //! | [`open`] | opening the link a [`LinkSpec`] names, starting the simulated form for `--sim` |
 //! | [`simulated`] | the whole thing on the in-process simulated form |
 //!
@@ -34,6 +35,7 @@ pub mod claim;
 pub mod control;
 pub mod drive;
 pub mod faults;
+pub mod forces;
 pub mod motion;
 pub mod open;
 pub mod plan;
@@ -56,6 +58,7 @@ pub use drive::{
     DriveAfterError, DriveError, DriveOptions, DriveReport, drive, drive_after,
 };
 pub use faults::{fault_names, state_name};
+pub use forces::{DEFAULT_FORCE_WINDOW, ForceSample};
 pub use motion::{ActuatorReport, MoveError, NodeProgress, PlannedTarget, Progress};
 pub use plan::{Clamped, plan};
 pub use reset::{ResetReport, reset};

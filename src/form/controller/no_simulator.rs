@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use form_description::FormDescription;
+use form_description::garment::GarmentSpec;
 
 use super::transport::Connection;
 
@@ -20,6 +21,13 @@ pub struct SimConfig {
     pub options: (),
     /// Write a candump log of the bus here.
     pub log: Option<PathBuf>,
+}
+
+impl SimConfig {
+    /// As in the simulator's build; here no simulated form exists to wear it.
+    pub fn wearing(self, _garment: Option<GarmentSpec>) -> Self {
+        self
+    }
 }
 
 /// A fault spec: in this build, none parses.

@@ -9,6 +9,7 @@
 use std::path::PathBuf;
 
 use form_description::FormDescription;
+use form_description::garment::GarmentSpec;
 use form_sim::bus::can::{CanBus, CanKind};
 use form_sim::bus::candump::CandumpLog;
 use form_sim::fault::FaultSpec;
@@ -40,6 +41,16 @@ impl Default for SimConfig {
             options: SimOptions::default(),
             log: None,
         }
+    }
+}
+
+impl SimConfig {
+    /// The same form wearing `garment` from power-on (`None`: as configured).
+    pub fn wearing(mut self, garment: Option<GarmentSpec>) -> Self {
+        if garment.is_some() {
+            self.options.garment = garment;
+        }
+        self
     }
 }
 

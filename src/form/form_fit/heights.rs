@@ -238,6 +238,7 @@ mod tests {
             stroke_mm: 10.0,
             max_speed_mm_s: 10.0,
             max_accel_mm_s2: 10.0,
+            force_limit_n: None,
             mirror: mirror.map(String::from),
         };
         let lifts = [lift("a", Some("b")), lift("c", None), lift("b", None), lift("d", Some("c"))];

@@ -457,6 +457,7 @@ mod tests {
                     stroke_mm: 60.0,
                     max_speed_mm_s: 10.0,
                     max_accel_mm_s2: 50.0,
+                    force_limit_n: None,
                     mirror: (k > 0 && k < 4).then(|| format!("a{partner}")),
                 }
             })

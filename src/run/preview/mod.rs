@@ -11,13 +11,18 @@
 //! - `form-fit.png` ([`form_fit_png`]): the robotic form's rings over the mannequin where the
 //!   lifts set them, and each ring seen from above: the mannequin's section there, the form's
 //!   skin and its panels coloured by their gap.
+//! - `fit.png` and `sweep.svg` ([`fit_png`], [`sweep_svg`]): a garment's fit test on the
+//!   form: each ring from above with its panels coloured by pressure, and the pressure
+//!   against girth through a size sweep.
 //!
 //! They draw the canonical frame: heights on the scan and on the mannequin line up.
 
+mod fit_test;
 mod form_fit;
 mod raster;
 mod sections;
 
+pub use fit_test::{fit_png, sweep_svg};
 pub use form_fit::form_fit_png;
 pub use sections::sections_svg;
 

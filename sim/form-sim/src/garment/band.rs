@@ -2,7 +2,8 @@
 
 use std::collections::BTreeMap;
 
-use form_description::{ActuatorSpec, FormDescription};
+use form_description::FormDescription;
+use form_description::skin::RingSkin;
 
 use super::BandSpec;
 
@@ -66,46 +67,27 @@ pub fn band_load(
     band: &BandSpec,
     positions_mm: &BTreeMap<String, f64>,
 ) -> Option<BandLoad> {
-    let ring = form.ring(&band.ring)?;
-    let actuators: Vec<&ActuatorSpec> =
-        form.actuators.iter().filter(|a| a.ring == ring.name).collect();
-    if actuators.is_empty() {
-        return None;
-    }
-    // The panels' ends, each with its panel's index.
-    let mut ends = Vec::with_capacity(2 * actuators.len());
-    for (k, a) in actuators.iter().enumerate() {
-        let e = positions_mm.get(&a.id).copied().unwrap_or(0.0);
-        ends.extend(a.panel_ends(ring.center_mm, e).map(|end| (end, k)));
-    }
-    let skin = convex_hull(ends);
-    let n = skin.len();
-    let edge = |i: usize| sub(skin[(i + 1) % n].0, skin[i].0);
-    let skin_girth_mm: f64 = (0..n).map(|i| norm(edge(i))).sum();
+    let skin = RingSkin::of(form, &band.ring, positions_mm)?;
+    let skin_girth_mm = skin.girth_mm();
     let ease_mm = band.relaxed_girth_mm - skin_girth_mm;
     let strain_percent = (100.0 * -ease_mm / band.relaxed_girth_mm).max(0.0);
     let tension_n_per_m = band.stretch().tension(strain_percent);
     let width_m = band.width_mm / MM_PER_M;
-    let mut panels: Vec<PanelLoad> = actuators
+    let mut panels: Vec<PanelLoad> = skin
+        .actuators
         .iter()
-        .map(|a| PanelLoad { actuator: a.id.clone(), force_n: 0.0, area_mm2: 0.0 })
+        .zip(skin.shares_mm())
+        .map(|(a, share)| PanelLoad {
+            actuator: a.id.clone(),
+            force_n: 0.0,
+            area_mm2: share * band.width_mm,
+        })
         .collect();
-    for i in 0..n {
-        let (before, after) = (edge((i + n - 1) % n), edge(i));
-        let (l_in, l_out) = (norm(before), norm(after));
-        if l_in == 0.0 || l_out == 0.0 {
-            continue;
-        }
-        // The band pulls the corner along both edges: net T (out - in) per unit width.
-        let pull = sub(scale(after, 1.0 / l_out), scale(before, 1.0 / l_in));
-        let panel = &mut panels[skin[i].1];
-        let [dx, dy] = actuators[skin[i].1].direction();
-        let inward = -(pull[0] * dx + pull[1] * dy);
-        panel.force_n += tension_n_per_m * width_m * inward.max(0.0);
-        panel.area_mm2 += 0.5 * (l_in + l_out) * band.width_mm;
+    for (panel, gain) in panels.iter_mut().zip(skin.gains()) {
+        panel.force_n = tension_n_per_m * width_m * gain.axial;
     }
     Some(BandLoad {
-        ring: ring.name.clone(),
+        ring: band.ring.clone(),
         skin_girth_mm,
         ease_mm,
         strain_percent,
@@ -115,51 +97,11 @@ pub fn band_load(
     })
 }
 
-fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-    [a[0] - b[0], a[1] - b[1]]
-}
-
-fn scale(a: [f64; 2], k: f64) -> [f64; 2] {
-    [a[0] * k, a[1] * k]
-}
-
-fn norm(a: [f64; 2]) -> f64 {
-    a[0].hypot(a[1])
-}
-
-/// The convex hull of `points` (each with a tag), counter-clockwise, without collinear or
-/// repeated points (Andrew's monotone chain). Written here, not taken from the host: the
-/// simulator does not depend on it, and a skin is a handful of points.
-fn convex_hull<T: Copy>(mut points: Vec<([f64; 2], T)>) -> Vec<([f64; 2], T)> {
-    points.sort_by(|a, b| a.0[0].total_cmp(&b.0[0]).then(a.0[1].total_cmp(&b.0[1])));
-    if points.len() < 3 {
-        return points;
-    }
-    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
-        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-    };
-    let mut hull: Vec<([f64; 2], T)> = Vec::with_capacity(2 * points.len());
-    for pass in [false, true] {
-        let start = hull.len();
-        let ordered: Box<dyn Iterator<Item = &([f64; 2], T)>> =
-            if pass { Box::new(points.iter().rev()) } else { Box::new(points.iter()) };
-        for &p in ordered {
-            while hull.len() >= start + 2
-                && cross(hull[hull.len() - 2].0, hull[hull.len() - 1].0, p.0) <= 0.0
-            {
-                hull.pop();
-            }
-            hull.push(p);
-        }
-        hull.pop();
-    }
-    hull
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::garment::{GarmentSpec, Stretch};
+    use form_description::ActuatorSpec;
     use std::f64::consts::TAU;
 
     /// A round ring of 16 panels, 60 mm from the axis retracted, 20 mm wide.
@@ -180,6 +122,7 @@ mod tests {
                 stroke_mm: 100.0,
                 max_speed_mm_s: 10.0,
                 max_accel_mm_s2: 50.0,
+                force_limit_n: None,
                 mirror: (k > 0 && k < 8).then(|| format!("p{}", 16 - k)),
             })
             .collect();

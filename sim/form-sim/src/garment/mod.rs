@@ -1,5 +1,5 @@
-//! A garment on the simulated form (issue 30, first part): what a garment is
-//! ([`GarmentSpec`], TOML) and the load it puts on the form's panels ([`band_load`]).
+//! A garment on the simulated form: the load a garment ([`GarmentSpec`], described in
+//! `form_description::garment`) puts on the form's panels ([`band_load`]).
 //!
 //! A garment is described per ring of the form as a band: its relaxed girth and how it
 //! stretches (a linear tension per unit width per percent of strain, or a measured
@@ -15,22 +15,11 @@
 //! radius of curvature of the panel layout; on a round ring `P = 2π T / C`.
 
 mod band;
-mod description;
 
 pub use band::{BandLoad, PanelLoad, band_load};
-pub use description::{
-    BandSpec, DEFAULT_BAND_WIDTH_MM, GarmentError, GarmentKind, GarmentSpec, Stretch,
+pub use form_description::garment::{
+    BandSpec, DEFAULT_BAND_WIDTH_MM, GarmentError, GarmentKind, GarmentSpec, SHIPPED, Stretch,
 };
-
-/// The shipped example garments (`sim/form-sim/garments/`), by name, for the reference form
-/// and the demo's customer (chest 960, waist 800, hip 1000 mm): a fitted woven dress, the
-/// same dress 5% too small at the waist, a jersey top and a compression body.
-pub const SHIPPED: [(&str, &str); 4] = [
-    ("woven-dress", include_str!("../../garments/woven-dress.toml")),
-    ("woven-dress-small-waist", include_str!("../../garments/woven-dress-small-waist.toml")),
-    ("jersey-top", include_str!("../../garments/jersey-top.toml")),
-    ("compression-garment", include_str!("../../garments/compression-garment.toml")),
-];
 
 #[cfg(test)]
 mod tests {

@@ -2,7 +2,7 @@
 //! panel it moves (which a jam or a broken encoder makes part ways with the plan).
 
 use firmware_protocol::update::shortest_duration_ms;
-use firmware_protocol::{Accel, HUNDREDTHS_PER_MM, Position, Speed};
+use firmware_protocol::{Accel, Force, HUNDREDTHS_PER_MM, HUNDREDTHS_PER_N, Position, Speed};
 use tokio::time::Instant;
 
 use super::motion::{Limits, Profile};
@@ -19,6 +19,9 @@ pub struct ActuatorConfig {
     /// Where the panel physically is at power-on, mm from home (before homing the node does
     /// not know it).
     pub start_mm: f64,
+    /// The rated force of its drive and force sensor, 0.01 N: the default and highest
+    /// `ForceLimit` (protocol 1.1).
+    pub rated_force: u16,
 }
 
 /// A fault of the physical actuator, injected by a test or a fault spec.
@@ -51,6 +54,8 @@ pub(super) struct ActuatorParams {
     pub following_error_limit: u16,
     /// Homing speed, 0.01 mm/s.
     pub homing_speed: u16,
+    /// The force that stalls the actuator, 0.01 N (protocol 1.1).
+    pub force_limit: u16,
 }
 
 /// The default following error limit, 0.01 mm (1 mm).
@@ -86,6 +91,9 @@ pub(super) struct ActuatorSim {
     pub encoder_broken: bool,
     /// The broken encoder has been reported since power-on.
     pub encoder_reported: bool,
+    /// The external load on the panel, N, positive inwards (a garment squeezing the form);
+    /// set by the simulated world around the node.
+    pub load_n: f64,
 }
 
 impl ActuatorSim {
@@ -101,6 +109,7 @@ impl ActuatorSim {
                 max_accel,
                 following_error_limit: FOLLOWING_ERROR_LIMIT,
                 homing_speed: HOMING_SPEED.min(max_speed),
+                force_limit: config.rated_force,
             },
             profile: Profile::hold(config.start_mm),
             since: now,
@@ -110,6 +119,7 @@ impl ActuatorSim {
             jammed_at: None,
             encoder_broken: false,
             encoder_reported: false,
+            load_n: 0.0,
         }
     }
 
@@ -121,6 +131,7 @@ impl ActuatorSim {
         Self {
             jammed_at: self.jammed_at,
             encoder_broken: self.encoder_broken,
+            load_n: self.load_n,
             ..Self::power_on(config, capability, now)
         }
     }
@@ -176,6 +187,26 @@ impl ActuatorSim {
         let (p, v) = self.planned(now);
         self.homing = None;
         self.plan(now, Profile::ramp(p, v, 0.0, self.limits().accel));
+    }
+
+    /// Stalls against a load over its force limit: stops where it is at once (the motor
+    /// cannot push on) and holds, abandoning a move or homing.
+    pub fn stall(&mut self, now: Instant) {
+        let position = self.position(now);
+        self.homing = None;
+        self.staged = None;
+        self.plan(now, Profile::hold(position));
+    }
+
+    /// Whether the load is over the force limit, either way (pushing the panel in, or
+    /// pulling it out).
+    pub fn over_force(&self) -> bool {
+        self.load_n.abs() * HUNDREDTHS_PER_N > f64::from(self.params.force_limit)
+    }
+
+    /// The force reading: the load plus `noise` (N), to 0.01 N.
+    pub fn measured_force(&self, noise: f64) -> Option<Force> {
+        Force::from_n(self.load_n + noise)
     }
 
     /// Starts the move to `target` lasting `duration_ms` (0: as fast as possible). Returns

@@ -40,6 +40,10 @@
 //!   heartbeat latches `HOST_TIMEOUT`. Like every fault and `EmergencyStop`, it stops every
 //!   actuator at its acceleration limit, turns the power stage off, drops staged targets and
 //!   sends `Emergency`.
+//! * A node of protocol 1.1 measures each actuator's load (what a garment presses on its
+//!   panel, [`Node::apply_load`]) and reports it with the feedback to a 1.1 host; an
+//!   actuator whose load is over its `ForceLimit` stalls where it is and the node latches
+//!   `OVER_FORCE`. A 1.0 node measures nothing.
 //! * A panel lagging its plan by more than `FollowingErrorLimit` (a jam) latches
 //!   `FOLLOWING_ERROR` and forgets that actuator's home; so does a broken encoder, whose
 //!   cause remains until the encoder works again, so `FaultReset` is refused.
@@ -59,13 +63,13 @@ use std::collections::VecDeque;
 use firmware_protocol::actuator::MAX_ACTUATORS;
 use firmware_protocol::drive::{AckStatus, DriveCommand, DriveState, EmergencyCode, Faults};
 use firmware_protocol::message::{
-    Ack, Capabilities, Direction, Emergency, Half, Heartbeat, Identity, MotionLimits, Param,
-    Positions8,
+    Ack, Capabilities, Direction, Emergency, Forces8, Half, Heartbeat, Identity, MotionLimits,
+    Param, Positions8,
 };
 use firmware_protocol::version::FirmwareVersion;
 use firmware_protocol::{
-    Accel, Actuator, ActuatorSet, Address, Code, HUNDREDTHS_PER_MM, Link, Message, NodeId,
-    PROTOCOL_VERSION, Packet, Position, ProtocolVersion, Speed,
+    Accel, Actuator, ActuatorSet, Address, Code, Force, HUNDREDTHS_PER_MM, HUNDREDTHS_PER_N, Link,
+    Message, NodeId, Packet, Position, ProtocolVersion, Speed,
 };
 use rand::SeedableRng;
 use rand::rngs::ChaCha8Rng;
@@ -94,6 +98,10 @@ pub struct NodeConfig {
     pub firmware: FirmwareVersion,
     /// Standard deviation of the position noise in feedback, mm (0 = none).
     pub noise_mm: f64,
+    /// Standard deviation of the force sensors' noise, N (0 = none).
+    pub force_noise_n: f64,
+    /// The protocol version it speaks: 1.0 nodes measure no force.
+    pub protocol: ProtocolVersion,
     /// Seed of the noise.
     pub seed: u64,
 }
@@ -115,6 +123,19 @@ pub struct ActuatorState {
     pub stalled: bool,
     /// The encoder is broken.
     pub encoder_fault: bool,
+    /// The external load on the panel, N, positive inwards.
+    pub load_n: f64,
+    /// Its force limit, N.
+    pub force_limit_n: f64,
+}
+
+/// A draw of `normal` (a sensor's noise of standard deviation `sd`) clipped at
+/// [`NOISE_CLIP`] standard deviations; 0 without noise.
+fn clipped(normal: &Option<Normal<f64>>, sd: f64, rng: &mut ChaCha8Rng) -> f64 {
+    match normal {
+        Some(normal) => normal.sample(rng).clamp(-NOISE_CLIP * sd, NOISE_CLIP * sd),
+        None => 0.0,
+    }
 }
 
 /// A simulated node and its actuators.
@@ -133,6 +154,7 @@ pub struct Node {
     pending: VecDeque<Emergency>,
     outbox: Vec<Packet>,
     noise: Option<Normal<f64>>,
+    force_noise: Option<Normal<f64>>,
     rng: ChaCha8Rng,
 }
 
@@ -142,6 +164,8 @@ impl Node {
     pub fn power_on(mut config: NodeConfig, now: Instant) -> Self {
         config.actuators.truncate(MAX_ACTUATORS);
         let noise = Normal::new(0.0, config.noise_mm).ok().filter(|_| config.noise_mm > 0.0);
+        let force_noise =
+            Normal::new(0.0, config.force_noise_n).ok().filter(|_| config.force_noise_n > 0.0);
         let rng = ChaCha8Rng::seed_from_u64(config.seed);
         let mut node = Self {
             actuators: Vec::new(),
@@ -154,6 +178,7 @@ impl Node {
             pending: VecDeque::new(),
             outbox: Vec::new(),
             noise,
+            force_noise,
             rng,
             config,
         };
@@ -217,6 +242,8 @@ impl Node {
                 staged: a.staged,
                 stalled: a.is_jammed(),
                 encoder_fault: a.encoder_broken,
+                load_n: a.load_n,
+                force_limit_n: f64::from(a.params.force_limit) / HUNDREDTHS_PER_N,
             })
             .collect()
     }
@@ -232,6 +259,17 @@ impl Node {
         self.advance(now);
         if let Some(a) = self.actuators.get_mut(actuator.index()) {
             a.inject(now, fault);
+        }
+    }
+
+    /// Puts an external load on one of its actuators, N, positive inwards (what a garment on
+    /// the form presses on the panel; ignored for an actuator it lacks). A node of protocol
+    /// 1.1 measures it, and stalls an actuator whose load is over its limit at its next tick.
+    /// The node's time does not move: only its own runner advances it (see `robot::runners`
+    /// on stalls).
+    pub fn apply_load(&mut self, actuator: Actuator, load_n: f64) {
+        if let Some(a) = self.actuators.get_mut(actuator.index()) {
+            a.load_n = load_n;
         }
     }
 
@@ -323,7 +361,9 @@ impl Node {
             | Message::Identity(_)
             | Message::Capabilities(_)
             | Message::ParamValue(_)
-            | Message::Ack(_) => {}
+            | Message::Ack(_)
+            | Message::Force(_)
+            | Message::AllForce(_) => {}
         }
     }
 
@@ -376,23 +416,46 @@ impl Node {
     fn send_feedback(&mut self, now: Instant) {
         let mut all = Positions8::default();
         for (slot, actuator) in all.positions.iter_mut().zip(&self.actuators) {
-            let noise = match &self.noise {
-                Some(normal) => {
-                    let limit = NOISE_CLIP * self.config.noise_mm;
-                    normal.sample(&mut self.rng).clamp(-limit, limit)
-                }
-                None => 0.0,
-            };
+            let noise = clipped(&self.noise, self.config.noise_mm, &mut self.rng);
             *slot = actuator.measured(now, noise);
         }
+        let halves = all.half(Half::Lower).positions.len() < self.actuators.len();
         match self.config.link {
             Link::ClassicCan => {
                 self.send(Message::Feedback(all.half(Half::Lower)));
-                if self.actuators.len() > MAX_ACTUATORS / 2 {
+                if halves {
                     self.send(Message::Feedback(all.half(Half::Upper)));
                 }
             }
             Link::CanFd | Link::Serial => self.send(Message::AllFeedback(all)),
+        }
+        if self.reports_force() {
+            self.send_forces();
+        }
+    }
+
+    /// Whether it sends forces: it measures them (1.1) and its host announced a version
+    /// that reads them.
+    fn reports_force(&self) -> bool {
+        self.config.protocol.has_force() && self.host.is_some_and(|(_, host)| host.has_force())
+    }
+
+    /// The forces of this link's feedback: the halves on classic CAN, `AllForce` otherwise.
+    fn send_forces(&mut self) {
+        let mut all = Forces8::default();
+        for (slot, actuator) in all.forces.iter_mut().zip(&self.actuators) {
+            let noise = clipped(&self.force_noise, self.config.force_noise_n, &mut self.rng);
+            *slot = actuator.measured_force(noise);
+        }
+        let halves = all.half(Half::Lower).forces.len() < self.actuators.len();
+        match self.config.link {
+            Link::ClassicCan => {
+                self.send(Message::Force(all.half(Half::Lower)));
+                if halves {
+                    self.send(Message::Force(all.half(Half::Upper)));
+                }
+            }
+            Link::CanFd | Link::Serial => self.send(Message::AllForce(all)),
         }
     }
 
@@ -470,6 +533,9 @@ impl Node {
         for (index, error) in faults {
             self.raise(now, EmergencyCode::FOLLOWING_ERROR, Some(index), error);
         }
+        if powered && self.config.protocol.has_force() {
+            self.check_forces(now);
+        }
         if self.state == DriveState::Homing && !self.actuators.iter().any(ActuatorSim::is_homing) {
             self.set_state(now, DriveState::Enabled);
         }
@@ -490,6 +556,22 @@ impl Node {
                 self.next_feedback = params::next_after(due, self.params.feedback_ms, now);
                 self.send_feedback(now);
             }
+        }
+    }
+
+    /// Stalls every actuator whose load is over its force limit and latches `OVER_FORCE`
+    /// (the others stop at their acceleration limits, as for any fault).
+    fn check_forces(&mut self, now: Instant) {
+        let mut over = Vec::new();
+        for (index, actuator) in Actuator::all().zip(self.actuators.iter_mut()) {
+            if actuator.over_force() {
+                actuator.stall(now);
+                let force = actuator.measured_force(0.0).unwrap_or(Force::MAX);
+                over.push((index, i32::from(force.hundredths_n())));
+            }
+        }
+        for (index, force) in over {
+            self.raise(now, EmergencyCode::OVER_FORCE, Some(index), force);
         }
     }
 
@@ -545,7 +627,7 @@ impl Node {
                         AckStatus::InvalidState
                     }
                     None => AckStatus::InvalidState,
-                    Some((_, host)) if host.major != PROTOCOL_VERSION.major => {
+                    Some((_, host)) if host.major != self.config.protocol.major => {
                         AckStatus::IncompatibleVersion
                     }
                     Some(_) => {
@@ -638,7 +720,7 @@ impl Node {
 
     fn identity(&self) -> Identity {
         Identity {
-            protocol: PROTOCOL_VERSION,
+            protocol: self.config.protocol,
             firmware: self.config.firmware,
             actuator_count: self.actuators.len() as u8,
         }

@@ -7,7 +7,7 @@ use firmware_protocol::timing::{FEEDBACK_PERIOD_MS, HEARTBEAT_PERIOD_MS, WATCHDO
 use tokio::time::{Duration, Instant};
 
 use super::Node;
-use super::actuator::ActuatorParams;
+use super::actuator::{ActuatorConfig, ActuatorParams};
 
 /// The node parameters (`0x00xx`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,6 +46,9 @@ const WATCHDOG_RANGE: std::ops::RangeInclusive<i32> = 10..=60_000;
 impl Node {
     /// The value of a parameter, or why not.
     pub(super) fn read_param(&self, read: ParamRead) -> Result<i32, AckStatus> {
+        if read.param.since_minor() > self.config.protocol.minor {
+            return Err(AckStatus::UnknownParameter);
+        }
         if read.param.is_per_actuator() {
             let actuator = read.actuator.ok_or(AckStatus::InvalidArgument)?;
             let a = self.actuators.get(actuator.index()).ok_or(AckStatus::InvalidArgument)?;
@@ -58,6 +61,8 @@ impl Node {
                 ParamId::MAX_ACCEL => p.max_accel,
                 ParamId::FOLLOWING_ERROR_LIMIT => p.following_error_limit,
                 ParamId::HOMING_SPEED => p.homing_speed,
+                ParamId::FORCE_LIMIT => p.force_limit,
+                ParamId::RATED_FORCE => a.config.rated_force,
                 _ => return Err(AckStatus::UnknownParameter),
             };
             return Ok(i32::from(value));
@@ -77,6 +82,9 @@ impl Node {
     /// Writes a parameter (for `None` on a per-actuator one: on every actuator, all or
     /// none), effective at once.
     pub(super) fn write_param(&mut self, now: Instant, write: Param) -> Result<(), AckStatus> {
+        if write.param.since_minor() > self.config.protocol.minor {
+            return Err(AckStatus::UnknownParameter);
+        }
         if write.param.is_per_actuator() {
             let indices: Vec<usize> = match write.actuator {
                 Some(a) if a.index() < self.actuators.len() => vec![a.index()],
@@ -87,8 +95,7 @@ impl Node {
             let mut updated = Vec::with_capacity(indices.len());
             for &i in &indices {
                 let a = &self.actuators[i];
-                let stroke = a.config.stroke.hundredths_mm();
-                updated.push(set_actuator_param(a.params, stroke, (speed, accel), write)?);
+                updated.push(set_actuator_param(a.params, &a.config, (speed, accel), write)?);
             }
             for (i, params) in indices.into_iter().zip(updated) {
                 self.actuators[i].params = params;
@@ -114,7 +121,7 @@ impl Node {
 /// `params` with one actuator parameter written, or why not.
 fn set_actuator_param(
     mut params: ActuatorParams,
-    stroke: u16,
+    config: &ActuatorConfig,
     (max_speed, max_accel): (u16, u16),
     write: Param,
 ) -> Result<ActuatorParams, AckStatus> {
@@ -125,14 +132,16 @@ fn set_actuator_param(
             .filter(|v| (lo..=hi).contains(v))
             .ok_or(AckStatus::InvalidArgument)
     };
+    let stroke = config.stroke.hundredths_mm();
     match write.param {
-        ParamId::STROKE => return Err(AckStatus::ReadOnlyParameter),
+        ParamId::STROKE | ParamId::RATED_FORCE => return Err(AckStatus::ReadOnlyParameter),
         ParamId::SOFT_LIMIT_MIN => params.soft_min = within(0, params.soft_max)?,
         ParamId::SOFT_LIMIT_MAX => params.soft_max = within(params.soft_min, stroke)?,
         ParamId::MAX_SPEED => params.max_speed = within(1, max_speed)?,
         ParamId::MAX_ACCEL => params.max_accel = within(1, max_accel)?,
         ParamId::FOLLOWING_ERROR_LIMIT => params.following_error_limit = within(1, u16::MAX - 1)?,
         ParamId::HOMING_SPEED => params.homing_speed = within(1, max_speed)?,
+        ParamId::FORCE_LIMIT => params.force_limit = within(1, config.rated_force)?,
         _ => return Err(AckStatus::UnknownParameter),
     }
     Ok(params)

@@ -24,12 +24,13 @@
 
 mod node_sim;
 mod runners;
+pub mod world;
 
 use std::sync::{Arc, Mutex};
 
 use firmware_protocol::drive::{DriveState, Faults};
 use firmware_protocol::version::FirmwareVersion;
-use firmware_protocol::{Actuator, Link, NodeId};
+use firmware_protocol::{Actuator, Force, Link, NodeId, PROTOCOL_VERSION, ProtocolVersion};
 use tokio::sync::oneshot;
 use tokio::task::JoinHandle;
 use tokio::time::{Duration, Instant};
@@ -37,10 +38,12 @@ use tokio::time::{Duration, Instant};
 use crate::bus::can::CanBus;
 use crate::bus::serial::SerialLine;
 use crate::fault::{FaultSpec, FaultSpecError, NodeSchedule};
+use crate::garment::GarmentSpec;
 use crate::node::{ActuatorConfig, ActuatorFault, ActuatorState, Node, NodeConfig};
 use form_description::FormDescription;
 use node_sim::NodeSim;
 use runners::{SharedCanary, SharedNode, Stalls, lock};
+use world::SharedGarment;
 
 /// How the simulated form behaves beyond its description.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,7 +60,28 @@ pub struct SimOptions {
     pub start_position_mm: f64,
     /// The firmware version nodes report (default 1.0.0).
     pub firmware: FirmwareVersion,
+    /// The protocol version nodes speak (default this crate's, 1.1; 1.0 nodes measure no
+    /// force).
+    pub protocol: ProtocolVersion,
+    /// The rated force of every actuator, N: the default and highest force limit (default
+    /// [`RATED_FORCE_N`]).
+    pub rated_force_n: f64,
+    /// Standard deviation of the force sensors' noise, N (default [`FORCE_NOISE_N`], clipped
+    /// at 4σ).
+    pub force_noise_n: f64,
+    /// The garment the form wears from power-on (default none; see
+    /// [`SimulatedForm::dress`]).
+    pub garment: Option<GarmentSpec>,
 }
+
+/// The simulated actuators' rated force, N: twice the description's default limit
+/// (`form_description::DEFAULT_FORCE_LIMIT_N`), so the limit the host writes is what stops
+/// them.
+pub const RATED_FORCE_N: f64 = 100.0;
+
+/// The simulated force sensors' noise, N (one standard deviation): 0.1% of the rated force,
+/// the combined error of a C3-class load cell (OIML R 60's 3000 divisions).
+pub const FORCE_NOISE_N: f64 = 0.1;
 
 impl Default for SimOptions {
     fn default() -> Self {
@@ -67,6 +91,10 @@ impl Default for SimOptions {
             seed: 0,
             start_position_mm: 2.0,
             firmware: FirmwareVersion { major: 1, minor: 0, patch: 0 },
+            protocol: PROTOCOL_VERSION,
+            rated_force_n: RATED_FORCE_N,
+            force_noise_n: FORCE_NOISE_N,
+            garment: None,
         }
     }
 }
@@ -133,6 +161,7 @@ impl FormState {
 pub struct SimulatedForm {
     description: FormDescription,
     nodes: Vec<SharedNode>,
+    garment: SharedGarment,
     tasks: Vec<JoinHandle<()>>,
 }
 
@@ -160,6 +189,8 @@ impl SimulatedForm {
     ) -> Result<Self, SimError> {
         let nodes = power_on(description, bus.kind().link(), faults, options, bus.origin())?;
         let start = Instant::now();
+        let garment: SharedGarment = Arc::new(Mutex::new(options.garment.clone()));
+        let world = world::run(description.clone(), nodes.clone(), garment.clone(), options.tick);
         let tasks = nodes
             .iter()
             .map(|node| {
@@ -173,8 +204,9 @@ impl SimulatedForm {
                 );
                 tokio::spawn(task)
             })
+            .chain([tokio::spawn(world)])
             .collect();
-        Ok(Self { description: description.clone(), nodes, tasks })
+        Ok(Self { description: description.clone(), nodes, garment, tasks })
     }
 
     /// Powers the form's nodes on behind a serial line; the caller runs the line with
@@ -185,7 +217,10 @@ impl SimulatedForm {
         options: &SimOptions,
     ) -> Result<Self, SimError> {
         let nodes = power_on(description, Link::Serial, faults, options, Instant::now())?;
-        Ok(Self { description: description.clone(), nodes, tasks: Vec::new() })
+        let garment: SharedGarment = Arc::new(Mutex::new(options.garment.clone()));
+        let world = world::run(description.clone(), nodes.clone(), garment.clone(), options.tick);
+        let tasks = vec![tokio::spawn(world)];
+        Ok(Self { description: description.clone(), nodes, garment, tasks })
     }
 
     /// Answers the host on `line` until `stop` (or an I/O error), then writes out the line's
@@ -225,6 +260,11 @@ impl SimulatedForm {
         let Some(shared) = self.node(node) else { return false };
         lock(shared).node.repair(Instant::now(), index);
         true
+    }
+
+    /// Puts `garment` on the form now (replacing what it wore), or takes it off (`None`).
+    pub fn dress(&self, garment: Option<GarmentSpec>) {
+        *lock(&self.garment) = garment;
     }
 
     /// Reboots a node's controller now; `false` if the form has no such node.
@@ -293,6 +333,8 @@ pub fn node_config(
             max_speed: a.max_speed().hundredths_mm_s(),
             max_accel: a.max_accel().tenths_mm_s2(),
             start_mm: options.start_position_mm.max(0.0).min(a.stroke_mm),
+            rated_force: Force::from_n(options.rated_force_n)
+                .map_or(0, |f| f.hundredths_n().max(0).unsigned_abs()),
         })
         .collect();
     NodeConfig {
@@ -301,6 +343,8 @@ pub fn node_config(
         actuators,
         firmware: options.firmware,
         noise_mm: options.noise_mm,
+        force_noise_n: options.force_noise_n,
+        protocol: options.protocol,
         seed: options.seed.wrapping_add(u64::from(node.get())),
     }
 }

@@ -6,7 +6,9 @@
 
 use firmware_protocol::drive::{DriveCommand, DriveState};
 use firmware_protocol::message::{Heartbeat, HostHeartbeat};
-use firmware_protocol::{ActuatorSet, Message, NodeId, PROTOCOL_VERSION, Packet, can};
+use firmware_protocol::{
+    ActuatorSet, Message, NodeId, PROTOCOL_VERSION, Packet, ProtocolVersion, can,
+};
 use form_sim::bus::can::{CanBus, CanPort};
 use tokio::time::{Duration, Instant, sleep_until};
 
@@ -19,6 +21,8 @@ pub struct TestHost {
     pub received: Vec<(Instant, Packet)>,
     /// Send a host heartbeat every 100 ms while running.
     pub heartbeats: bool,
+    /// The protocol version its heartbeats announce (default this crate's).
+    pub protocol: ProtocolVersion,
     next_heartbeat: Instant,
 }
 
@@ -36,6 +40,7 @@ impl TestHost {
             port: bus.attach(),
             received: Vec::new(),
             heartbeats: false,
+            protocol: PROTOCOL_VERSION,
             next_heartbeat: Instant::now(),
         }
     }
@@ -74,7 +79,8 @@ impl TestHost {
                 return false;
             }
             if self.heartbeats && now >= self.next_heartbeat {
-                self.queue([Packet::broadcast(host_heartbeat())]);
+                let heartbeat = HostHeartbeat { protocol: self.protocol };
+                self.queue([Packet::broadcast(Message::HostHeartbeat(heartbeat))]);
                 self.next_heartbeat = now + HEARTBEAT_PERIOD;
             }
             let wake = if self.heartbeats { deadline.min(self.next_heartbeat) } else { deadline };
@@ -115,7 +121,18 @@ impl TestHost {
                     .is_some_and(|h| h.state == DriveState::Enabled && h.homed == ActuatorSet::ALL)
             })
         };
-        assert!(self.run_until(deadline, all_homed).await, "the nodes did not all home");
+        let homed = self.run_until(deadline, all_homed).await;
+        let events: Vec<_> = self
+            .received
+            .iter()
+            .filter(|(_, p)| matches!(p.message, Message::Emergency(_)))
+            .map(|(at, p)| (at.elapsed(), p))
+            .collect();
+        assert!(
+            homed,
+            "the nodes did not all home: {:?}, events {events:?}",
+            self.last_heartbeats(nodes)
+        );
     }
 }
 

@@ -9,8 +9,9 @@
 use std::time::Duration;
 
 use firmware_protocol::drive::{AckStatus, DriveCommand, DriveState};
-use firmware_protocol::message::Heartbeat;
-use firmware_protocol::{ActuatorSet, Message, NodeId, Packet};
+use firmware_protocol::message::{Heartbeat, Param};
+use firmware_protocol::param::ParamId;
+use firmware_protocol::{Actuator, ActuatorSet, Message, NodeId, PROTOCOL_VERSION, Packet};
 use tokio::time::Instant;
 
 use super::requests::ATTEMPTS;
@@ -29,8 +30,11 @@ impl<T: Transport> Session<T> {
     }
 
     /// Enables `node` and homes its actuators whose home is unknown (latched faults are
-    /// [`Session::reset_faults`]'s). Does not wait for homing to finish.
+    /// [`Session::reset_faults`]'s). A node that measures force (protocol 1.1) is first
+    /// given its actuators' force limits from the description (a node forgets them when it
+    /// reboots, so every enable sets them). Does not wait for homing to finish.
     pub async fn enable(&mut self, node: NodeId) -> Result<(), SessionError> {
+        self.set_force_limits(node).await?;
         // A recent host heartbeat first: nodes refuse Enable without one (InvalidState), so
         // after a lost heartbeat, another heartbeat and another try.
         let mut attempts = 1;
@@ -58,6 +62,39 @@ impl<T: Transport> Session<T> {
                 status.heartbeat =
                     status.heartbeat.map(|h| Heartbeat { state: DriveState::Homing, ..h });
             }
+        }
+        Ok(())
+    }
+
+    /// Whether `node` measures force: it speaks protocol 1.1 or later (from its identity).
+    pub fn measures_force(&self, node: NodeId) -> bool {
+        self.nodes
+            .get(&node)
+            .and_then(|s| s.identity)
+            .is_some_and(|i| i.protocol.has_force() && PROTOCOL_VERSION.has_force())
+    }
+
+    /// Writes the description's force limits to `node`'s actuators, if it measures force:
+    /// one `ParamWrite` for the whole node when they agree (the reference form's do), else
+    /// one per actuator.
+    async fn set_force_limits(&mut self, node: NodeId) -> Result<(), SessionError> {
+        if !self.measures_force(node) {
+            return Ok(());
+        }
+        let limits: Vec<(Option<Actuator>, i32)> = self
+            .form
+            .actuators_of(node)
+            .iter()
+            .map(|a| (a.actuator(), i32::from(a.force_limit().hundredths_n())))
+            .collect();
+        let writes = match limits.first() {
+            Some(&(_, first)) if limits.iter().all(|&(_, l)| l == first) => vec![(None, first)],
+            _ => limits,
+        };
+        for (actuator, value) in writes {
+            let write = Param { param: ParamId::FORCE_LIMIT, actuator, value };
+            let answer = self.request(Packet::node(node, Message::ParamWrite(write))).await?;
+            self.expect_ok(node, "ParamWrite ForceLimit", answer).await?;
         }
         Ok(())
     }

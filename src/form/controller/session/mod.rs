@@ -12,7 +12,7 @@
 //! | `enable.rs` | enabling, homing, waiting until ready, disabling |
 //!
 //! Packet handling (here): every received packet updates its node's [`NodeStatus`] (heartbeat,
-//! positions, identity, events); packets from addresses the description lacks are recorded as
+//! positions, forces, identity, events); packets from addresses the description lacks are recorded as
 //! unexpected nodes; a node whose heartbeat falls back to Disabled unasked (or forgets its
 //! homes) has rebooted. Received packets are always taken before silence is judged, and while
 //! the session waits, heartbeats and polls go on (see `liveness.rs`).
@@ -36,8 +36,10 @@ use std::time::Duration;
 
 use firmware_protocol::actuator::MAX_ACTUATORS;
 use firmware_protocol::drive::DriveState;
-use firmware_protocol::message::{Capabilities, Emergency, Heartbeat, Identity, Positions8};
-use firmware_protocol::{Address, Link, Message, NodeId, Packet, Position};
+use firmware_protocol::message::{
+    Capabilities, Emergency, Forces8, Heartbeat, Identity, Positions8,
+};
+use firmware_protocol::{Address, Force, Link, Message, NodeId, Packet, Position};
 use form_description::FormDescription;
 use tokio::sync::watch;
 use tokio::time::{Instant, sleep_until};
@@ -68,6 +70,11 @@ pub struct NodeStatus {
     pub heartbeat_at: Option<Instant>,
     /// Its actuators' last reported positions (`None`: unknown).
     pub positions: [Option<Position>; MAX_ACTUATORS],
+    /// Its actuators' last measured forces (protocol 1.1; `None`: not measured).
+    pub forces: [Option<Force>; MAX_ACTUATORS],
+    /// How many force readings it has sent (a classic CAN frame's half counts), so a reader
+    /// can wait for fresh ones.
+    pub force_readings: u64,
     /// When it was last heard from, in the session's listening time.
     pub heard: Option<Duration>,
     /// The link's stalls excused up to then (see [`Session::excused`]): later stalls are
@@ -219,6 +226,16 @@ impl<T: Transport> Session<T> {
                 status.positions = all.positions;
             }
             Message::AllFeedback(all) => status.positions = all.positions,
+            Message::Force(four) => {
+                let mut all = Forces8 { forces: status.forces };
+                all.set_half(&four);
+                status.forces = all.forces;
+                status.force_readings += 1;
+            }
+            Message::AllForce(all) => {
+                status.forces = all.forces;
+                status.force_readings += 1;
+            }
             Message::Emergency(e) => status.events.push(e),
             Message::Identity(i) => status.identity = Some(i),
             Message::Capabilities(c) => status.capabilities = Some(c),

@@ -1,4 +1,7 @@
-//! The garment description: TOML, validated against the form it is put on.
+//! Garment descriptions: a garment put on the form, per ring a band with its relaxed girth
+//! and how it stretches; TOML, validated against the form it is put on. The simulator puts
+//! its load on the panels (`form_sim::garment`); the host's fit test reads its girths.
+//! [`SHIPPED`] are the example garments in `form-description/garments/`.
 //!
 //! ```toml
 //! name = "jersey top"
@@ -20,8 +23,23 @@
 
 use std::collections::HashSet;
 
-use form_description::FormDescription;
+use super::description::FormDescription;
 use serde::Deserialize;
+
+/// The shipped example garments (`form-description/garments/`), by name, for the reference
+/// form and the demo's customer (chest 960, waist 800, hip 1000 mm): a fitted woven dress,
+/// the same dress 5% too small at the waist, a jersey top and a compression body.
+pub const SHIPPED: [(&str, &str); 4] = [
+    ("woven-dress", include_str!("../garments/woven-dress.toml")),
+    ("woven-dress-small-waist", include_str!("../garments/woven-dress-small-waist.toml")),
+    ("jersey-top", include_str!("../garments/jersey-top.toml")),
+    ("compression-garment", include_str!("../garments/compression-garment.toml")),
+];
+
+/// A shipped garment's description text, by name.
+pub fn shipped(name: &str) -> Option<&'static str> {
+    SHIPPED.iter().find(|(n, _)| *n == name).map(|(_, text)| *text)
+}
 
 /// How tall a band is on its ring when the description does not say, mm: the height of the
 /// garment a ring's panels carry, about the spacing of a dress form's measurement levels
