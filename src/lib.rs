@@ -23,7 +23,8 @@
 //! 5. [`run`]: one call per command and its results: [`run::pipeline`], [`run::reconstruct`]
 //!    (pose symmetry, then the mannequin), [`run::outputs`] (a result as its set of files),
 //!    [`atomic_output`] (all-or-nothing writes), [`run::preview`] (`preview.png`,
-//!    `sections.svg`) and [`run::info`] (what `dressform info` says about a scan).
+//!    `sections.svg`), [`run::report`] (`report.html`, the customer report) and [`run::info`]
+//!    (what `dressform info` says about a scan).
 //!
 //! Used by all of them: [`messages`] (how a problem is worded: one bounded line) and [`input`]
 //! (reading the JSON files a user hands in).

@@ -60,6 +60,7 @@ fn reconstruct(
             "posed.obj",
             "preview.png",
             "profiles.json",
+            "report.html",
             "rigged.glb",
             "sections.svg"
         ],

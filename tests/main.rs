@@ -35,6 +35,7 @@ mod pose_symmetry;
 mod pose_symmetry_cases;
 mod pose_symmetry_proportions;
 mod preview;
+mod report;
 mod run_end_to_end;
 mod segmentation;
 mod segmentation_arms_down;

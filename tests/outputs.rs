@@ -30,7 +30,14 @@ fn glb_for_cad_and_the_set_replaced_as_a_whole() {
     let names: Vec<String> = output_files(&out).into_iter().map(|(n, _)| n).collect();
     assert_eq!(
         names,
-        ["mannequin.glb", "measurements.json", "preview.png", "profiles.json", "sections.svg"],
+        [
+            "mannequin.glb",
+            "measurements.json",
+            "preview.png",
+            "profiles.json",
+            "report.html",
+            "sections.svg"
+        ],
         "no mannequin.obj left"
     );
     let glb = dressform::body::scan::read_mesh_file(&out.join("mannequin.glb")).unwrap().0;
@@ -52,7 +59,7 @@ fn glb_for_cad_and_the_set_replaced_as_a_whole() {
     let (code, _, stderr) = symmetrize(&[scan, "-o", out_s, "--scan-frame", "--up", "y"]);
     assert_eq!(code, 2, "{stderr}");
     // A failed command leaves the set as it was.
-    assert_eq!(output_files(&out).len(), 5);
+    assert_eq!(output_files(&out).len(), 6);
     assert!(out.join("mannequin.glb").is_file());
 
     // PLY in centimetres, Z up: read back with its header.
@@ -83,7 +90,7 @@ fn the_same_input_gives_the_same_bytes() {
             output_files(&out)
         })
         .collect();
-    assert_eq!(runs[0].len(), 5, "mannequin, profiles, measurements and the two pictures");
+    assert_eq!(runs[0].len(), 6, "mannequin, profiles, measurements, the two pictures, report");
     for run in &runs[1..] {
         for ((name, a), (_, b)) in runs[0].iter().zip(run) {
             assert!(a == b, "{name} differs between runs");

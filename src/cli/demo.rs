@@ -1,14 +1,15 @@
-//! `dressform demo [--out DIR] [--seed N]`: the whole system on a built-in synthetic customer —
-//! generate a body with known measurements (`capture-sim`), asymmetric (one arm further out,
-//! one leg out), scan it with a typical scanner's artifacts (noise, holes, metres, Y up,
-//! turned), encode the scan as PLY and read it back, re-pose it symmetric (the body model
-//! fitted to it), build the symmetric mannequin, fit the reference form and drive the simulated
-//! form over the in-process bus — then compare the customer's true girths with the scan's, the
-//! pose-symmetric scan's and the mannequin's.
+//! `dressform demo [--out DIR] [--seed N] [--report PATH]`: the whole system on a built-in
+//! synthetic customer — generate a body with known measurements (`capture-sim`), asymmetric
+//! (one arm further out, one leg out), scan it with a typical scanner's artifacts (noise,
+//! holes, metres, Y up, turned), encode the scan as PLY and read it back, re-pose it symmetric
+//! (the body model fitted to it), build the symmetric mannequin, fit the reference form and
+//! drive the simulated form over the in-process bus — then compare the customer's true girths
+//! with the scan's, the pose-symmetric scan's and the mannequin's. The customer report
+//! (`report.html`) names the customer by its seed.
 
 use super::drive::{SimArgs, shape_verdict};
-use super::run::{Drive, Prepared, Reconstruct, shape_form};
-use super::{Failure, LegArgs, progress_bar};
+use super::run::{Drive, Prepared, Reconstruct, ReportTo, shape_form};
+use super::{Failure, LegArgs, ReportArgs, progress_bar};
 use capture_sim::{Artifacts, BodyParams, GroundTruth, Pose, capture, generate};
 use dressform::atomic_output::OutputSet;
 use dressform::body::mesh::{Mesh, smooth::DEFAULT_PASSES};
@@ -34,6 +35,8 @@ pub struct DemoArgs {
     seed: Option<u64>,
     #[command(flatten)]
     legs: LegArgs,
+    #[command(flatten)]
+    report: ReportArgs,
 }
 
 /// How much further out the customer holds the left arm than the right (degrees of
@@ -61,9 +64,10 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
     };
     let form = form_description::reference();
     let (seed, out, legs) = (args.seed, args.out.clone(), args.legs.options());
+    let report = ReportTo { customer: Some(customer_name(seed)), also: args.report.clone() };
     // The customer is made and scanned once the simulated form is claimed (see `shape_form`).
     let (done, shape, truth) =
-        shape_form(&form, &drive, &args.out, move || customer(seed, &out, legs))?;
+        shape_form(&form, &drive, &args.out, move || customer(seed, &out, legs, report))?;
     outln!();
     outln!(
         "  {:<12} {:>9} {:>9} {:>11} {:>11}",
@@ -97,20 +101,30 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
     }
     outln!();
     outln!(
-        "Written to {}: scan.ply, posed.obj (the scan re-posed symmetric), rigged.glb, fit.json, mannequin.obj, profiles.json, measurements.json, setpoints.json, form-fit.png (the form over the mannequin), preview.png (the scan, the pose-symmetric scan and the mannequin), sections.svg",
+        "Written to {}: scan.ply, posed.obj (the scan re-posed symmetric), rigged.glb, fit.json, mannequin.obj, profiles.json, measurements.json, setpoints.json, form-fit.png (the form over the mannequin), preview.png (the scan, the pose-symmetric scan and the mannequin), sections.svg, report.html (all of it on one page, to read or print)",
         args.out.display()
     );
     shape_verdict(&shape)
 }
 
+/// How the report names the customer of `seed` (the default one without).
+fn customer_name(seed: Option<u64>) -> String {
+    match seed {
+        Some(seed) => format!("synthetic customer, seed {seed}"),
+        None => "synthetic customer (the demo's own)".to_string(),
+    }
+}
+
 /// The synthetic customer of `seed` (the default one without), standing asymmetrically and
 /// scanned with a typical scanner's artifacts, its scan encoded as PLY into the outputs and
-/// read back; what it is and how it was scanned printed; its mannequin built with `legs`.
-/// Returns the prepared scan and the customer's true measurements.
+/// read back; what it is and how it was scanned printed; its mannequin built with `legs`, its
+/// report written as `report` says. Returns the prepared scan and the customer's true
+/// measurements.
 fn customer(
     seed: Option<u64>,
     out: &Path,
     legs: MannequinOptions,
+    report: ReportTo,
 ) -> Result<Prepared<GroundTruth>, Failure> {
     let bar = progress_bar(false, 3);
     let params = seed.map_or_else(BodyParams::default, BodyParams::random);
@@ -166,5 +180,5 @@ fn customer(
     outln!();
     let options = ReconstructOptions { mannequin: legs, ..Default::default() };
     let reconstruct = Reconstruct { model: BodyModel::builtin(), options };
-    Ok(Prepared { scan, reconstruct, outputs, extra: customer.truth })
+    Ok(Prepared { scan, reconstruct, outputs, extra: customer.truth, report })
 }

@@ -23,8 +23,10 @@ use dressform::form::fit_test::sweep::{self, DEFAULT_SWEEP, SweepRange, SweepSte
 use dressform::form::fit_test::{self, FitTest};
 use dressform::form::form_fit::{Targets, compare, fit, regions_of};
 use dressform::form::setpoints::SetPoints;
+use dressform::run::outputs::{GARMENT_FIT, REPORT, SWEEP, fit_test_report};
 use dressform::run::preview::{fit_png, sweep_svg};
 use dressform::run::reconstruct::ReconstructOptions;
+use dressform::run::report;
 use dressform::shape::profiles::Profiles;
 use form_description::FormDescription;
 use form_description::garment::{GarmentSpec, SHIPPED, shipped};
@@ -33,7 +35,7 @@ use serde::Serialize;
 use super::drive::{ShapeArgs, SimArgs, execute_through, shape_verdict};
 use super::link::{FormArg, LinkArgs};
 use super::run::{Drive, Moves, Prepared, Reconstruct, shape_form_through};
-use super::{Failure, FrameArgs, SmoothArgs, print_warnings};
+use super::{Failure, FrameArgs, ReportArgs, SmoothArgs, print_warnings};
 
 /// The customer the form is shaped to.
 #[derive(Debug, clap::Args)]
@@ -66,8 +68,8 @@ pub struct FitTestArgs {
     /// customer's, mm, reading the pressure at each step.
     #[arg(long, value_name = "FROM:TO:STEP", num_args = 0..=1, default_missing_value = DEFAULT_SWEEP, allow_hyphen_values = true)]
     sweep: Option<String>,
-    /// Where to write fit-test.json, fit.png (and with --sweep sweep.svg); with --scan, what
-    /// `run` writes goes into its folder `customer`.
+    /// Where to write fit-test.json, fit.png (and with --sweep sweep.svg) and report.html;
+    /// with --scan, what `run` writes goes into its folder `customer`.
     #[arg(long, default_value = "dressform-fit-test")]
     out: PathBuf,
     /// Print the report as JSON on standard output.
@@ -80,6 +82,8 @@ pub struct FitTestArgs {
     frame: FrameArgs,
     #[command(flatten)]
     smooth: SmoothArgs,
+    #[command(flatten)]
+    report: ReportArgs,
 }
 
 /// The fit test's JSON (`fit-test.json`).
@@ -157,7 +161,8 @@ pub fn run(args: &FitTestArgs) -> Result<(), Failure> {
                     scan::prepare(&scan_path, &scan_options).map_err(Failure::bad_input)?;
                 print_warnings(&scan.source.display().to_string(), &warnings, None);
                 let reconstruct = Reconstruct { model, options: ReconstructOptions::default() };
-                Ok(Prepared { scan, reconstruct, outputs: OutputSet::new(), extra: () })
+                let report = Default::default();
+                Ok(Prepared { scan, reconstruct, outputs: OutputSet::new(), extra: (), report })
             };
             let moves = Moves { steps: Box::new(steps_of), garment: Some(garment.clone()) };
             // The pipeline's outputs are a set of their own, beside the fit test's.
@@ -184,7 +189,8 @@ pub fn run(args: &FitTestArgs) -> Result<(), Failure> {
         sweep::analyse(steps, COMFORT_LIMIT_KPA)
     });
     let fit = &fits[at];
-    write_outputs(&args.out, &form, fit, &reports[at], swept.as_ref())?;
+    let (customer, copy) = (&args.customer, &args.report);
+    write_outputs(&args.out, &form, fit, &reports[at], swept.as_ref(), customer, copy)?;
     if args.json {
         let report = Report { format: FORMAT, fit, sweep: swept.as_ref() };
         outln!("{}", serde_json::to_string_pretty(&report).map_err(Failure::other)?);
@@ -240,21 +246,31 @@ fn assess_step(
     fit_test::assess(form, garment, &girths, &report.positions_mm, &report.forces)
 }
 
-/// `fit-test.json`, `fit.png` and `sweep.svg` into `out`, as one set.
+/// `fit-test.json`, `fit.png`, `sweep.svg` and the report of the fit test on `customer` into
+/// `out`, as one set; the report also where `copy` says.
 fn write_outputs(
     out: &Path,
     form: &FormDescription,
     fit: &FitTest,
     report: &DriveReport,
     swept: Option<&sweep::Sweep>,
+    customer: &CustomerArgs,
+    copy: &ReportArgs,
 ) -> Result<(), Failure> {
     let mut outputs = OutputSet::new();
     let json = Report { format: FORMAT, fit, sweep: swept };
     let text = serde_json::to_string_pretty(&json).map_err(Failure::other)?;
     outputs.add("fit-test.json", text + "\n");
-    outputs.add("fit.png", fit_png(form, fit, &report.positions_mm));
+    outputs.add(GARMENT_FIT, fit_png(form, fit, &report.positions_mm));
     if let Some(swept) = swept {
-        outputs.add("sweep.svg", sweep_svg(swept));
+        outputs.add(SWEEP, sweep_svg(swept));
     }
-    outputs.commit(out).map_err(Failure::other)
+    // The customer: the mannequin's folder's name, or the scan's file stem (else as given).
+    let (folder, scan) = (customer.mannequin.as_deref(), customer.scan.as_deref());
+    let name = folder.and_then(Path::file_name).or(scan.and_then(Path::file_stem));
+    let name = name.or(folder.or(scan).map(Path::as_os_str)).unwrap_or_default();
+    let name = name.to_string_lossy().into_owned();
+    let html = report::render(&fit_test_report(name, fit, swept, &outputs));
+    outputs.add(REPORT, html);
+    copy.commit(outputs, out)
 }

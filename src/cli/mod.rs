@@ -54,15 +54,18 @@ use no_simulator::{demo, sim};
 
 use clap::builder::{PossibleValue, PossibleValuesParser, RangedU64ValueParser, TypedValueParser};
 use clap::{Parser, Subcommand};
+use dressform::atomic_output::{OutputSet, write_atomically};
 use dressform::body::mesh::smooth;
 use dressform::body::scan::Scan;
 use dressform::body::scan::format::{Export, Format, Placement, UpAxis};
 use dressform::body::scan::frame::{Direction, FrameOptions, Units};
 use dressform::messages;
+use dressform::run::outputs::REPORT;
 use dressform::shape::mannequin::{LegStance, MannequinOptions, StopAt};
 use dressform::shape::symmetry::Preserve;
 use std::io::{ErrorKind, Write};
 use std::ops::{Bound, RangeBounds};
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Personalized symmetric mannequins from 3D body scans, and the robotic dress form they drive.
@@ -335,6 +338,28 @@ impl ExportArgs {
             (placement, false) => placement.clone(),
         };
         Export::new(format, placement).map_err(Failure::bad_input)
+    }
+}
+
+/// `--report PATH`: the customer report (`report.html`) of a command's output set, also
+/// written to a file of the user's choice.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct ReportArgs {
+    /// Also write the customer report (report.html) to this file.
+    #[arg(long, value_name = "PATH")]
+    report: Option<PathBuf>,
+}
+
+impl ReportArgs {
+    /// Commits `set` into `out`, then writes its report to `--report`'s file, if one is
+    /// given, atomically.
+    fn commit(&self, set: OutputSet, out: &Path) -> Result<(), Failure> {
+        let copy = self.report.as_deref().zip(set.get(REPORT).map(<[u8]>::to_vec));
+        set.commit(out).map_err(Failure::other)?;
+        match copy {
+            Some((path, html)) => write_atomically(path, &html).map_err(Failure::other),
+            None => Ok(()),
+        }
     }
 }
 

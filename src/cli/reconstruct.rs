@@ -1,10 +1,11 @@
 //! `dressform reconstruct <scan> -o <dir> [--model model.glb] [--pose pose.toml]
-//! [--format ...] [--units ...] [--up ...] [--scan-frame] [--json]`: pose symmetry, then the
-//! mannequin (see [`dressform::run::reconstruct`]).
+//! [--format ...] [--units ...] [--up ...] [--scan-frame] [--json] [--report PATH]`: pose
+//! symmetry, then the mannequin (see [`dressform::run::reconstruct`]).
 
 use super::symmetrize::pretty_json;
 use super::{
-    ExportArgs, Failure, MannequinArgs, ScanFrameArgs, SmoothArgs, print_warnings, progress_bar,
+    ExportArgs, Failure, MannequinArgs, ReportArgs, ScanFrameArgs, SmoothArgs, print_warnings,
+    progress_bar,
 };
 use dressform::body::scan::{self, ScanOptions};
 use dressform::pose::body_model::BodyModel;
@@ -22,7 +23,7 @@ pub struct ReconstructArgs {
     scan: PathBuf,
     /// Output directory (created if missing): posed.obj and mannequin.obj (or .ply, .stl,
     /// .glb), rigged.glb, profiles.json, measurements.json, fit.json, preview.png,
-    /// sections.svg, replaced as a whole.
+    /// sections.svg, report.html, replaced as a whole.
     #[arg(short, long)]
     out: PathBuf,
     /// The body model (.glb) [default: the built-in model].
@@ -42,6 +43,8 @@ pub struct ReconstructArgs {
     frame: ScanFrameArgs,
     #[command(flatten)]
     smooth: SmoothArgs,
+    #[command(flatten)]
+    report: ReportArgs,
 }
 
 pub fn run(args: &ReconstructArgs) -> Result<(), Failure> {
@@ -67,7 +70,7 @@ pub fn run(args: &ReconstructArgs) -> Result<(), Failure> {
     bar.set_message("writing");
 
     let outputs = Outputs::reposed(&done.result, &done.reposed, &done.as_scanned, &scan, &export);
-    outputs.files().map_err(Failure::other)?.commit(&args.out).map_err(Failure::other)?;
+    args.report.commit(outputs.files().map_err(Failure::other)?, &args.out)?;
     bar.finish_and_clear();
     if args.json {
         outln!("{}", pretty_json(&done.reposed.fit_report())?);

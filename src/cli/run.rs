@@ -1,15 +1,16 @@
 //! `dressform run <scan> [--form <form.toml>] (--sim | --serial <path> | --slcan <path> |
 //! --can <iface>) [--out <dir>] [--model <model.glb>] [--pose <pose.toml>]
-//! [--girth-tolerance <mm>] [--reset-faults]`: scan to shaped form in one command — pose
-//! symmetry (the body model fitted, the scan re-posed symmetric), the symmetric mannequin, the
-//! set-points that give the form its shape, the drive — and a final report comparing the
-//! scan's, the pose-symmetric scan's, the mannequin's and the form's girths at every ring.
+//! [--girth-tolerance <mm>] [--reset-faults] [--report PATH]`: scan to shaped form in one
+//! command — pose symmetry (the body model fitted, the scan re-posed symmetric), the symmetric
+//! mannequin, the set-points that give the form its shape, the drive — and a final report
+//! comparing the scan's, the pose-symmetric scan's, the mannequin's and the form's girths at
+//! every ring.
 //! Exit status 3 when a ring did not reach the mannequin's girth.
 
 use super::drive::{ShapeArgs, SimArgs, execute_through, shape_verdict};
 use super::link::{FormArg, LinkArgs};
 use super::setpoints::fidelity_table;
-use super::{Failure, FrameArgs, LegArgs, SmoothArgs, print_warnings, progress_bar};
+use super::{Failure, FrameArgs, LegArgs, ReportArgs, SmoothArgs, print_warnings, progress_bar};
 use dressform::atomic_output::OutputSet;
 use dressform::body::scan::{self, Scan, ScanOptions, format::Export, format::Format};
 use dressform::form::controller::{DriveOptions, DriveReport, LinkSpec};
@@ -37,7 +38,8 @@ pub struct RunArgs {
     #[command(flatten)]
     shape: ShapeArgs,
     /// Where to write mannequin.obj, posed.obj, rigged.glb, fit.json, profiles.json,
-    /// measurements.json, setpoints.json, preview.png and sections.svg.
+    /// measurements.json, setpoints.json, preview.png, sections.svg, form-fit.png and
+    /// report.html.
     #[arg(long, default_value = "dressform-run")]
     out: PathBuf,
     /// The body model (.glb) [default: the built-in model].
@@ -52,6 +54,8 @@ pub struct RunArgs {
     smooth: SmoothArgs,
     #[command(flatten)]
     legs: LegArgs,
+    #[command(flatten)]
+    report: ReportArgs,
 }
 
 pub fn run(args: &RunArgs) -> Result<(), Failure> {
@@ -64,6 +68,7 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     let scan_options = ScanOptions { frame: args.frame.options(), smooth: args.smooth.smooth };
     let (model_path, pose_path) = (args.model.clone(), args.pose.clone());
     let legs = args.legs.options();
+    let report = ReportTo { customer: None, also: args.report.clone() };
     let prepare = move || {
         let model = super::model::load(model_path.as_deref())?;
         let pose = super::reconstruct::pose_overrides(pose_path.as_deref(), &model)?;
@@ -72,7 +77,7 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
         print_warnings(&scan.source.display().to_string(), &warnings, None);
         let options = ReconstructOptions { pose, mannequin: legs, ..Default::default() };
         let reconstruct = Reconstruct { model, options };
-        Ok(Prepared { scan, reconstruct, outputs: OutputSet::new(), extra: () })
+        Ok(Prepared { scan, reconstruct, outputs: OutputSet::new(), extra: (), report })
     };
     let (_, shape, ()) = shape_form(&form, &drive, &args.out, prepare)?;
     shape_verdict(&shape)
@@ -98,8 +103,18 @@ pub struct Reconstruct {
     pub options: ReconstructOptions,
 }
 
+/// Whom the customer report (`report.html`) of `run` and `demo` names, and where else it goes.
+#[derive(Debug, Clone, Default)]
+pub struct ReportTo {
+    /// The customer (default: the scan's file stem).
+    pub customer: Option<String>,
+    /// `--report`.
+    pub also: ReportArgs,
+}
+
 /// What `run` and `demo` prepare before the reconstruction: the scan, how to reconstruct it,
-/// the output files made on the way, and anything else the caller wants back (`extra`).
+/// the output files made on the way, the report's customer and copy, and anything else the
+/// caller wants back (`extra`).
 pub struct Prepared<X> {
     /// The scan, in the canonical frame and prepared ([`scan::prepare`]).
     pub scan: Scan,
@@ -109,6 +124,8 @@ pub struct Prepared<X> {
     pub outputs: OutputSet,
     /// The caller's own.
     pub extra: X,
+    /// Whom the report names and where else it goes.
+    pub report: ReportTo,
 }
 
 /// The chain shared by `run` and `demo`: the form claimed first (its endpoint and signals
@@ -171,8 +188,9 @@ pub fn shape_form_through<X: Send + 'static>(
     );
     let compute = move || {
         errln!("{claimed}");
-        let Prepared { scan, reconstruct, outputs, extra } = prepare()?;
-        let done = reconstruct_and_write(&scan, &reconstruct, &shape_of, &out_dir, outputs)?;
+        let Prepared { scan, reconstruct, outputs, extra, report } = prepare()?;
+        let done =
+            reconstruct_and_write(&scan, &reconstruct, &shape_of, &out_dir, outputs, &report)?;
         let steps = (moves.steps)(&done.shaped.setpoints);
         let at = steps.iter().position(|s| *s == done.shaped.setpoints).unwrap_or(0);
         Ok(((done, extra, at), steps))
@@ -207,13 +225,15 @@ pub fn shape_form_through<X: Send + 'static>(
 }
 
 /// Pose symmetry, mannequin and set-points of `scan`, committed into `out` with the files
-/// already in `outputs` as one set, and the fit and the form's fit printed.
+/// already in `outputs` as one set (the report as `report` says), and the fit and the form's
+/// fit printed.
 fn reconstruct_and_write(
     scan: &Scan,
     reconstruct: &Reconstruct,
     form: &FormDescription,
     out: &Path,
     mut outputs: OutputSet,
+    report: &ReportTo,
 ) -> Result<Reshaped, Failure> {
     let file = scan.source.display().to_string();
     let bar = progress_bar(false, (STEPS.len() + SHAPE_STEPS.len()) as u64);
@@ -223,11 +243,14 @@ fn reconstruct_and_write(
     })
     .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
     let (shaped, export) = (&done.shaped, Export::canonical(Format::Obj));
-    let files =
+    let mut files =
         Outputs::reposed(&shaped.symmetrized, &done.reposed, &done.as_scanned, scan, &export)
             .with_form(form, &shaped.fit, &shaped.setpoints);
+    if let Some(customer) = &report.customer {
+        files = files.with_customer(customer);
+    }
     outputs.append(files.files().map_err(Failure::other)?);
-    outputs.commit(out).map_err(Failure::other)?;
+    report.also.commit(outputs, out)?;
     bar.finish_and_clear();
 
     let over = |r: &&RegionResidual| r.median_mm / r.max_median_mm;

@@ -1,9 +1,10 @@
 //! `dressform symmetrize <scan> -o <dir> [--torso-layers N] [--leg-layers N] [--rays N]
 //! [--preserve tape|contour] [--format obj|ply|stl|glb] [--units mm|cm|m] [--up z|y]
-//! [--scan-frame] [--json]`.
+//! [--scan-frame] [--json] [--report PATH]`.
 
 use super::{
-    ExportArgs, Failure, MannequinArgs, ScanFrameArgs, SmoothArgs, print_warnings, progress_bar,
+    ExportArgs, Failure, MannequinArgs, ReportArgs, ScanFrameArgs, SmoothArgs, print_warnings,
+    progress_bar,
 };
 use dressform::body::scan::{self, ScanOptions};
 use dressform::run::outputs::Outputs;
@@ -16,7 +17,8 @@ pub struct SymmetrizeArgs {
     /// The scan: an .obj, .ply or .stl file.
     scan: PathBuf,
     /// Output directory (created if missing): mannequin.obj (or .ply, .stl, .glb),
-    /// profiles.json, measurements.json, preview.png, sections.svg, replaced as a whole.
+    /// profiles.json, measurements.json, preview.png, sections.svg, report.html, replaced as a
+    /// whole.
     #[arg(short, long)]
     out: PathBuf,
     #[command(flatten)]
@@ -30,6 +32,8 @@ pub struct SymmetrizeArgs {
     frame: ScanFrameArgs,
     #[command(flatten)]
     smooth: SmoothArgs,
+    #[command(flatten)]
+    report: ReportArgs,
 }
 
 pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
@@ -51,7 +55,7 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     bar.set_message("writing");
 
     let outputs = Outputs::of(&result, &scan, &export).files().map_err(Failure::other)?;
-    outputs.commit(&args.out).map_err(Failure::other)?;
+    args.report.commit(outputs, &args.out)?;
     bar.finish_and_clear();
     if args.json {
         outln!("{}", pretty_json(&result.comparison)?);

@@ -10,18 +10,25 @@
 //! | [`FORM_FIT`] | with a form: its rings over the mannequin and each ring from above |
 //! | [`PREVIEW`] | the scan (and the pose-symmetric scan) and the mannequin in three views |
 //! | [`SECTIONS`] | the chest, waist and hip sections of both (paper Fig. 9 and 11) |
+//! | [`REPORT`] | the customer report: the pictures, the measurements, the form's fit ([`crate::run::report`]) |
 //! | `posed.<ext>` | after pose symmetry: the pose-symmetric scan, as the [`Export`] says |
 //! | [`RIGGED`] | after pose symmetry: the scan with the fitted skeleton and its skin weights |
 //! | [`FIT`] | after pose symmetry: the fit ([`crate::run::reconstruct::FitReport`]) |
+//!
+//! `fit-test` writes a set of its own: `fit-test.json`, [`GARMENT_FIT`], [`SWEEP`] with a size
+//! sweep, and its [`REPORT`] ([`fit_test_report`]).
 
 use crate::atomic_output::OutputSet;
 use crate::body::scan::Scan;
 use crate::body::scan::format::Export;
+use crate::form::fit_test::FitTest;
+use crate::form::fit_test::sweep::Sweep;
 use crate::form::form_fit::FormFit;
 use crate::form::setpoints::SetPoints;
 use crate::run::pipeline::Symmetrized;
 use crate::run::preview::{form_fit_png, preview_png, sections_svg};
 use crate::run::reconstruct::{AsScanned, MeasurementsReport, Reposed};
+use crate::run::report::{self, Figure, FitTestPart, FormPart, Measured, Report, SweepPart};
 use form_description::FormDescription;
 
 /// The mannequin's file name without its extension (the export adds it).
@@ -44,6 +51,12 @@ pub const POSED: &str = "posed";
 pub const RIGGED: &str = "rigged.glb";
 /// What the fit found and the symmetric pose.
 pub const FIT: &str = "fit.json";
+/// The customer report.
+pub const REPORT: &str = "report.html";
+/// The fit test's picture of the garment on the form (`fit-test`).
+pub const GARMENT_FIT: &str = "fit.png";
+/// The fit test's size sweep (`fit-test --sweep`).
+pub const SWEEP: &str = "sweep.svg";
 
 /// The files of a mannequin made from a scan (`symmetrize`), after pose symmetry
 /// (`reconstruct`), with the form's set-points when a form was fitted to it (`run`, `demo`).
@@ -58,12 +71,14 @@ pub struct Outputs<'a> {
     /// The input scan, how it was re-posed and what it measured as it stood, after pose
     /// symmetry.
     reposed: Option<(&'a Scan, &'a Reposed, &'a AsScanned)>,
+    /// Who the report names (default: the scan's file stem).
+    customer: Option<&'a str>,
 }
 
 impl<'a> Outputs<'a> {
     /// The files of `result`, the mannequin of `scan`, its own file written as `export` says.
     pub fn of(result: &'a Symmetrized, scan: &'a Scan, export: &'a Export) -> Self {
-        Outputs { result, scan, export, form: None, reposed: None }
+        Outputs { result, scan, export, form: None, reposed: None, customer: None }
     }
 
     /// The files of `result`, the mannequin of the pose-symmetric scan of `reposed`, made from
@@ -88,6 +103,11 @@ impl<'a> Outputs<'a> {
         setpoints: &'a SetPoints,
     ) -> Self {
         Outputs { form: Some((form, fit, setpoints)), ..self }
+    }
+
+    /// With the customer the report names (instead of the scan's file stem).
+    pub fn with_customer(self, customer: &'a str) -> Self {
+        Outputs { customer: Some(customer), ..self }
     }
 
     /// The set of files (see the module documentation).
@@ -117,6 +137,70 @@ impl<'a> Outputs<'a> {
                 set.add(FIT, serde_json::to_vec_pretty(&reposed.fit_report())?);
             }
         }
+        let html = report::render(&self.report(&set));
+        set.add(REPORT, html);
         Ok(set)
+    }
+
+    /// The customer report of these outputs, its pictures those of `set` (their files).
+    fn report<'s>(&self, set: &'s OutputSet) -> Report<'s>
+    where
+        'a: 's,
+    {
+        let figure = |file, caption| Figure::of(set, file, caption);
+        let (preview, measured) = match self.reposed {
+            None => ("The scan and the mannequin, front, side and back", "the scan"),
+            Some(_) => (
+                "The scan as it stood, the pose-symmetric scan and the mannequin, front, side \
+                 and back",
+                "the pose-symmetric scan",
+            ),
+        };
+        let sections = "The chest, waist and hip seen from above, front at the bottom: the \
+                        scan, its halves mirrored and the symmetric mannequin";
+        let form_fit = "The form's rings over the mannequin, and each ring from above, each \
+                        panel coloured by its gap";
+        let form =
+            self.form.map(|(_, fit, _)| FormPart { fit, figure: figure(FORM_FIT, form_fit) });
+        let source = &self.scan.source;
+        let stem = source.file_stem().unwrap_or(source.as_os_str()).to_string_lossy();
+        Report {
+            customer: self.customer.map_or_else(|| stem.into_owned(), str::to_string),
+            date: report::today_utc(),
+            body: [figure(PREVIEW, preview), figure(SECTIONS, sections)]
+                .into_iter()
+                .flatten()
+                .collect(),
+            measurements: Some(Measured::of(self.scan, measured)),
+            form,
+            fit_test: None,
+        }
+    }
+}
+
+/// The customer report of a garment's fit test on `customer`: at the customer's girths (`fit`)
+/// and through the size `sweep`, when one was run; its pictures the files of `set`
+/// ([`GARMENT_FIT`], [`SWEEP`]).
+pub fn fit_test_report<'s>(
+    customer: String,
+    fit: &'s FitTest,
+    sweep: Option<&'s Sweep>,
+    set: &'s OutputSet,
+) -> Report<'s> {
+    let garment = "Each ring the garment covers seen from above, its panels coloured by their \
+                   pressure";
+    let swept = "Each ring's mean pressure through the size sweep";
+    let fit_test = FitTestPart {
+        fit,
+        figure: Figure::of(set, GARMENT_FIT, garment),
+        sweep: sweep.map(|sweep| SweepPart { sweep, figure: Figure::of(set, SWEEP, swept) }),
+    };
+    Report {
+        customer,
+        date: report::today_utc(),
+        body: Vec::new(),
+        measurements: None,
+        form: None,
+        fit_test: Some(fit_test),
     }
 }
