@@ -26,6 +26,7 @@ use dressform::form::setpoints::SetPoints;
 use dressform::run::pipeline::symmetrize;
 use dressform::shape::mannequin::MannequinOptions;
 use dressform::shape::profiles::Profiles;
+use firmware_protocol::drive::DriveState;
 use firmware_protocol::version::PROTOCOL_1_0;
 use form_description::garment::{GarmentSpec, shipped};
 use form_description::{FormDescription, reference};
@@ -111,7 +112,16 @@ async fn the_shipped_garments_fit_the_customer_as_described() {
             }
             "woven-dress-small-waist" => assert_eq!(flagged, ["waist"], "{name}"),
             "jersey-top" => assert!(flagged.is_empty(), "{name}: {flagged:?}"),
-            _ => {}
+            "compression-garment" => {
+                let class = |r: &dressform::form::fit_test::RingFit| match r.verdict {
+                    Verdict::Class(c) | Verdict::AboveClass(c) => c,
+                    other => panic!("{}: {other:?}", r.ring),
+                };
+                let waist = fit.rings.iter().find(|r| r.ring == "waist").unwrap();
+                assert!(fit.rings.iter().all(|r| class(r) <= class(waist)), "{fit:?}");
+                assert!(class(waist) >= 2, "{waist:?}");
+            }
+            other => panic!("a shipped garment this test does not know: {other}"),
         }
     }
 }
@@ -151,7 +161,9 @@ async fn a_sweep_finds_where_each_ring_crosses_the_comfort_limit_within_one_step
             SweepStep { delta_mm, fit }
         })
         .collect();
-    let result = sweep::analyse(swept, COMFORT_LIMIT_KPA);
+    let result = sweep::analyse(swept, sweep::limit_for(garment.kind));
+    assert_eq!(result.limit_kpa, COMFORT_LIMIT_KPA);
+    assert!(result.saturated_mm.is_empty(), "{}", sweep::table(&result));
     assert_eq!(result.crossings.len(), 3, "{}", sweep::table(&result));
     for crossing in &result.crossings {
         let band = garment.bands.iter().find(|b| b.ring == crossing.ring).unwrap();
@@ -168,7 +180,7 @@ async fn a_sweep_finds_where_each_ring_crosses_the_comfort_limit_within_one_step
         );
     }
     let binds = result.binds.as_ref().unwrap();
-    assert!(result.crossings.iter().all(|c| c.delta_mm >= binds.delta_mm));
+    assert!(result.crossings.iter().all(|c| c.delta_mm >= binds.delta_mm && !c.from_start));
     let [lo, hi] = result.usable_mm.unwrap();
     assert!(lo == -40.0 && hi < binds.delta_mm, "{lo}..{hi} vs {}", binds.delta_mm);
 }
@@ -263,4 +275,68 @@ fn the_fit_test_command_reports_writes_its_files_and_stops_on_over_force() {
     let (code, _, stderr) = run(args(&path(&bad)));
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("bad.toml") && stderr.contains("no ring `knee`"), "{stderr}");
+}
+
+/// A form whose waist actuators ask for a 150 N limit, above the simulated actuators' rated
+/// 100 N: refused before any node is enabled, naming the node, the limit and the rated force.
+#[tokio::test(start_paused = true)]
+async fn a_force_limit_above_the_rated_force_is_refused_before_anything_is_enabled() {
+    let mut spec = reference().into_spec();
+    for a in spec.actuators.iter_mut().filter(|a| a.ring == "waist") {
+        a.force_limit_n = Some(150.0);
+    }
+    let form = FormDescription::try_from(spec).unwrap();
+    let rig = SimulatedRig::start(&form, &SimConfig::default()).unwrap();
+    let error = dressform::form::controller::drive(
+        rig.attach(),
+        &form,
+        customer(),
+        &DriveOptions::default(),
+        |_| {},
+    )
+    .await
+    .unwrap_err();
+    let message = error.to_string();
+    assert!(message.contains("force limit of 150 N, above its rated force of 100 N"), "{message}");
+    let truth = rig.truth();
+    assert!(truth.nodes.iter().all(|n| n.state == DriveState::Disabled), "{truth:?}");
+}
+
+/// A garment that presses a panel over its limit with the form at home: the node faults as it
+/// is enabled; every node is stopped and disabled, and the error names the panel and force.
+#[tokio::test(start_paused = true)]
+async fn a_panel_over_its_limit_at_home_stops_every_node_as_they_are_enabled() {
+    let form = reference();
+    let text = "name = \"tiny\"\n[[band]]\nring = \"waist\"\nrelaxed_girth_mm = 400\n\
+                tension_n_per_m_per_percent = 300\n";
+    let config = SimConfig::default().wearing(Some(garment(&form, text)));
+    let rig = SimulatedRig::start(&form, &config).unwrap();
+    let error =
+        dressform::form::controller::drive(rig.attach(), &form, customer(), &reading(), |_| {})
+            .await
+            .unwrap_err();
+    let message = error.to_string();
+    assert!(message.contains("waist-") && message.contains("over its force limit"), "{message}");
+    let truth = rig.truth();
+    let powered = |s: DriveState| matches!(s, DriveState::Enabled | DriveState::Homing);
+    assert!(truth.nodes.iter().all(|n| !powered(n.state)), "{truth:?}");
+}
+
+/// A node that reboots while the forces are read voids the reading: the test fails saying so,
+/// with every node stopped, rather than judging the garment on positions it lost.
+#[tokio::test(start_paused = true)]
+async fn a_node_rebooting_while_the_forces_are_read_voids_the_reading() {
+    let form = reference();
+    let garment = garment(&form, shipped("jersey-top").unwrap());
+    let config = SimConfig { faults: "node4:reboot@15s".parse().unwrap(), ..SimConfig::default() }
+        .wearing(Some(garment));
+    let rig = SimulatedRig::start(&form, &config).unwrap();
+    let long = DriveOptions { read_forces: Some(std::time::Duration::from_secs(20)), ..reading() };
+    let error = dressform::form::controller::drive(rig.attach(), &form, customer(), &long, |_| {})
+        .await
+        .unwrap_err();
+    let message = error.to_string();
+    assert!(message.contains("node 4") && message.contains("reading is void"), "{message}");
+    let truth = rig.truth();
+    assert!(truth.nodes.iter().all(|n| n.state != DriveState::Enabled), "{truth:?}");
 }

@@ -29,6 +29,7 @@ mod mannequin;
 mod mannequin_file;
 mod mannequin_population;
 mod mannequin_quality;
+mod measure_plausibility;
 mod measurements;
 mod outputs;
 mod pose_symmetry;

@@ -58,7 +58,7 @@ const LEGS_TOGETHER_DEG: f64 = 2.0;
 
 /// The stances of the acceptance list, as changes to a random A-posed customer.
 #[derive(Debug, Clone, Copy)]
-enum Stance {
+pub(crate) enum Stance {
     APose,
     SlightlyAsymmetric,
     OneArmHorizontal,
@@ -69,7 +69,8 @@ enum Stance {
 }
 
 impl Stance {
-    fn params(self, seed: u64) -> BodyParams {
+    /// The customer `seed` of the generator in this stance.
+    pub(crate) fn params(self, seed: u64) -> BodyParams {
         let mut p = BodyParams::random(seed);
         let left = seed.is_multiple_of(2);
         let pose = &mut p.pose;

@@ -203,7 +203,8 @@ pub struct LiftSpec {
     pub max_speed_mm_s: f64,
     /// Acceleration (and deceleration) limit, mm/s².
     pub max_accel_mm_s2: f64,
-    /// The force that stalls it, N; default [`DEFAULT_FORCE_LIMIT_N`].
+    /// The force that stalls it, N; without one the host leaves the node's own limit (its
+    /// rated force): a lift carries its rings' weight, which no panel's limit fits.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub force_limit_n: Option<f64>,
     /// Id of its mirror partner, for a lift raising rings on one side only (a left thigh's
@@ -228,11 +229,12 @@ pub struct Axis<'a> {
     pub max_speed_mm_s: f64,
     /// Acceleration (and deceleration) limit, mm/s².
     pub max_accel_mm_s2: f64,
-    /// The force that stalls it, N (the description's, or [`DEFAULT_FORCE_LIMIT_N`]).
-    pub force_limit_n: f64,
+    /// The force that stalls it, N: the description's, a panel's default
+    /// [`DEFAULT_FORCE_LIMIT_N`], or none for a lift without one (the node's rated force).
+    pub force_limit_n: Option<f64>,
 }
 
-/// The force limit of an actuator or lift whose description gives none, N. A safety margin
+/// The force limit of a panel's actuator whose description gives none, N. A safety margin
 /// on both sides: twice the 25 N a panel of the reference form carries under a firm
 /// compression garment (4 kPa over an 80 × 80 mm panel), and under half of the 110 N that
 /// ISO/TS 15066 (Table A.2) allows as a quasi-static contact force on the abdomen, the
@@ -248,7 +250,7 @@ impl<'a> From<&'a ActuatorSpec> for Axis<'a> {
             stroke_mm: a.stroke_mm,
             max_speed_mm_s: a.max_speed_mm_s,
             max_accel_mm_s2: a.max_accel_mm_s2,
-            force_limit_n: a.force_limit_n.unwrap_or(DEFAULT_FORCE_LIMIT_N),
+            force_limit_n: Some(a.force_limit_n.unwrap_or(DEFAULT_FORCE_LIMIT_N)),
         }
     }
 }
@@ -262,7 +264,7 @@ impl<'a> From<&'a LiftSpec> for Axis<'a> {
             stroke_mm: l.stroke_mm,
             max_speed_mm_s: l.max_speed_mm_s,
             max_accel_mm_s2: l.max_accel_mm_s2,
-            force_limit_n: l.force_limit_n.unwrap_or(DEFAULT_FORCE_LIMIT_N),
+            force_limit_n: l.force_limit_n,
         }
     }
 }
@@ -283,9 +285,10 @@ impl Axis<'_> {
         Accel::from_mm_s2(self.max_accel_mm_s2).unwrap_or_default()
     }
 
-    /// The force limit in the protocol's unit (validation keeps it in range).
-    pub fn force_limit(&self) -> Force {
-        Force::from_n(self.force_limit_n).unwrap_or(Force::ZERO)
+    /// The force limit in the protocol's unit, if the description sets one (validation keeps
+    /// it in range).
+    pub fn force_limit(&self) -> Option<Force> {
+        self.force_limit_n.and_then(Force::from_n)
     }
 
     /// Its node's id, if the address is valid.

@@ -12,6 +12,9 @@ use std::collections::BTreeMap;
 
 use super::description::{ActuatorSpec, FormDescription};
 
+/// kPa per N/mm²: a force over a contact area in mm² as a pressure.
+pub const KPA_PER_N_PER_MM2: f64 = 1000.0;
+
 /// One corner of a ring's skin: a panel's end.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SkinCorner {
@@ -162,7 +165,51 @@ fn convex_hull(mut points: Vec<SkinCorner>) -> Vec<SkinCorner> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::reference;
+    use crate::{ActuatorSpec, reference};
+
+    /// Four panels 100 mm wide at 100 mm from the axis: the skin is an octagon whose corners
+    /// (the panels' ends) all turn 45 degrees. At a corner the band's pull per unit tension is
+    /// `2 sin(22.5°)` = 0.765 across the corner, of which 0.707 lies along the panel's
+    /// actuator (by hand: the edges leave along (1, 0) and (1, 1)/√2). Each panel has two
+    /// corners: axial √2, normal 4 sin(π/8).
+    #[test]
+    fn a_bands_press_splits_into_the_actuators_part_and_the_guides_by_hand() {
+        let mut spec = reference().into_spec();
+        spec.lifts.clear();
+        spec.nodes.retain(|n| n.address == 1);
+        spec.rings.retain(|r| r.name == "chest");
+        spec.actuators = (0..4)
+            .map(|k| ActuatorSpec {
+                id: format!("p{k}"),
+                node: 1,
+                channel: k as u8,
+                ring: "chest".into(),
+                angle_deg: 90.0 * k as f64,
+                base_radius_mm: 100.0,
+                panel_width_mm: 100.0,
+                stroke_mm: 50.0,
+                max_speed_mm_s: 10.0,
+                max_accel_mm_s2: 50.0,
+                force_limit_n: None,
+                mirror: match k {
+                    1 => Some("p3".into()),
+                    _ => None,
+                },
+            })
+            .collect();
+        let form = FormDescription::try_from(spec).unwrap();
+        let skin = RingSkin::of(&form, "chest", &BTreeMap::new()).unwrap();
+        assert_eq!(skin.corners.len(), 8);
+        let quarter = std::f64::consts::FRAC_PI_8;
+        for gain in skin.gains() {
+            assert!((gain.axial - 2.0f64.sqrt()).abs() < 1e-9, "{gain:?}");
+            assert!((gain.normal - 4.0 * quarter.sin()).abs() < 1e-9, "{gain:?}");
+        }
+        for share in skin.shares_mm() {
+            // Its own 100 mm and half of each 70.7 mm gap edge beside it.
+            assert!((share - (100.0 + 50.0 * 2.0f64.sqrt())).abs() < 1e-9, "{share}");
+        }
+    }
 
     /// On the reference form's waist, retracted and extended: the shares add up to the girth,
     /// the side panels carry the skin while the front and back ones lie under their

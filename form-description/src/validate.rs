@@ -446,8 +446,8 @@ impl FormSpec {
             ),
             (
                 "force_limit_n",
-                a.force_limit_n,
-                a.force_limit_n >= MIN_FORCE_N && a.force_limit_n <= max_force,
+                a.force_limit_n.unwrap_or(max_force),
+                a.force_limit_n.is_none_or(|f| f >= MIN_FORCE_N && f <= max_force),
                 "in 0.01..=327.67",
             ),
         ];
@@ -578,8 +578,8 @@ impl FormSpec {
                 ("max_accel_mm_s2", lift.max_accel_mm_s2, partner.max_accel_mm_s2),
                 (
                     "force_limit_n",
-                    Axis::from(lift).force_limit_n,
-                    Axis::from(partner).force_limit_n,
+                    lift.force_limit_n.unwrap_or(0.0),
+                    partner.force_limit_n.unwrap_or(0.0),
                 ),
             ];
             if let Some((field, x, y)) = limits.iter().find(|(_, x, y)| !close(*x, *y)) {
@@ -660,7 +660,11 @@ impl FormSpec {
             ("stroke_mm", a.stroke_mm, b.stroke_mm),
             ("max_speed_mm_s", a.max_speed_mm_s, b.max_speed_mm_s),
             ("max_accel_mm_s2", a.max_accel_mm_s2, b.max_accel_mm_s2),
-            ("force_limit_n", Axis::from(a).force_limit_n, Axis::from(b).force_limit_n),
+            (
+                "force_limit_n",
+                Axis::from(a).force_limit_n.unwrap_or(0.0),
+                Axis::from(b).force_limit_n.unwrap_or(0.0),
+            ),
             ("base_radius_mm", a.base_radius_mm, b.base_radius_mm),
             ("panel_width_mm", a.panel_width_mm, b.panel_width_mm),
         ];

@@ -18,7 +18,6 @@ use std::path::{Path, PathBuf};
 use dressform::atomic_output::OutputSet;
 use dressform::body::scan::{self, ScanOptions};
 use dressform::form::controller::{DEFAULT_FORCE_WINDOW, DriveOptions, DriveReport};
-use dressform::form::fit_test::comfort::COMFORT_LIMIT_KPA;
 use dressform::form::fit_test::sweep::{self, DEFAULT_SWEEP, SweepRange, SweepStep};
 use dressform::form::fit_test::{self, FitTest};
 use dressform::form::form_fit::{Targets, compare, fit, regions_of};
@@ -65,15 +64,17 @@ pub struct FitTestArgs {
     #[command(flatten)]
     shape: ShapeArgs,
     /// Step every ring the garment covers through this range of girths around the
-    /// customer's, mm, reading the pressure at each step.
-    #[arg(long, value_name = "FROM:TO:STEP", num_args = 0..=1, default_missing_value = DEFAULT_SWEEP, allow_hyphen_values = true)]
+    /// customer's, mm, reading the pressure at each step (`--sweep`, or `--sweep=-20:60:10`;
+    /// the range includes 0).
+    #[arg(long, value_name = "FROM:TO:STEP", num_args = 0..=1, require_equals = true, default_missing_value = DEFAULT_SWEEP, allow_hyphen_values = true)]
     sweep: Option<String>,
     /// Where to write fit-test.json, fit.png (and with --sweep sweep.svg) and report.html;
     /// with --scan, what `run` writes goes into its folder `customer`.
     #[arg(long, default_value = "dressform-fit-test")]
     out: PathBuf,
-    /// Print the report as JSON on standard output.
-    #[arg(long)]
+    /// Print the report as JSON on standard output (with --mannequin; with --scan the
+    /// pipeline reports in text, and fit-test.json has the fit).
+    #[arg(long, conflicts_with = "scan")]
     json: bool,
     /// The body model (.glb), with --scan [default: the built-in model].
     #[arg(long)]
@@ -124,11 +125,11 @@ pub fn run(args: &FitTestArgs) -> Result<(), Failure> {
     };
     let (base, reports, shape) = match (&args.customer.mannequin, &args.customer.scan) {
         (Some(dir), _) => {
-            let profiles_path = dir.join("profiles.json");
-            let (fit_form, path) = (form.clone(), profiles_path.clone());
+            // Read before the form is claimed: a bad folder moves nothing.
+            let path = dir.join("profiles.json");
+            let profiles = Profiles::load(&path, &regions_of(&form)).map_err(Failure::bad_input)?;
+            let fit_form = form.clone();
             let compute = move || {
-                let profiles =
-                    Profiles::load(&path, &regions_of(&fit_form)).map_err(Failure::bad_input)?;
                 let fitted = fit(&profiles, &fit_form)
                     .map_err(|e| Failure::bad_input(format!("{}: {e}", path.display())))?;
                 let base = fitted.setpoints();
@@ -144,6 +145,12 @@ pub fn run(args: &FitTestArgs) -> Result<(), Failure> {
                 args.json,
                 compute,
             )?;
+            for (id, asked, used) in reports.iter().flat_map(|r| &r.clamped) {
+                errln!("warning: {id}: {asked} mm is outside the stroke, clamped to {used} mm");
+            }
+            for warning in reports.iter().flat_map(|r| &r.warnings) {
+                errln!("warning: {warning}");
+            }
             let at = customer_step(&reports, range);
             let targets =
                 Targets { girths_mm: &base.target_girths_mm, heights_mm: &base.target_heights_mm };
@@ -186,7 +193,7 @@ pub fn run(args: &FitTestArgs) -> Result<(), Failure> {
             .zip(&fits)
             .map(|(delta_mm, fit)| SweepStep { delta_mm, fit: fit.clone() })
             .collect();
-        sweep::analyse(steps, COMFORT_LIMIT_KPA)
+        sweep::analyse(steps, sweep::limit_for(garment.kind))
     });
     let fit = &fits[at];
     let (customer, copy) = (&args.customer, &args.report);
@@ -200,7 +207,8 @@ pub fn run(args: &FitTestArgs) -> Result<(), Failure> {
             outln!("size sweep ({} steps):", swept.steps.len());
             out!("{}", sweep::table(swept));
         }
-        outln!("fit-test.json and fit.png written to {}", args.out.display());
+        let svg = if swept.is_some() { ", sweep.svg" } else { "" };
+        outln!("fit-test.json, fit.png{svg} and report.html written to {}", args.out.display());
     }
     shape_verdict(&shape)
 }

@@ -1,16 +1,17 @@
 //! What the form feels at rest (protocol 1.1): every actuator's measured force, averaged over
 //! a window after a move, so a fit test reads a garment's load without the sensors' noise.
 //!
-//! Nodes send forces with their feedback (every 20 ms on CAN, with every poll on serial);
-//! [`read_forces`] keeps the session alive for the window, takes every fresh reading, and
-//! watches for faults meanwhile: an actuator over its force limit (`OVER_FORCE`) stops the
-//! form as any fault does.
+//! Nodes send forces with their feedback (every 20 ms on CAN, with every poll on serial); the
+//! session adds up every reading as its frame arrives ([`super::session::ForceSum`]).
+//! [`read_forces`] clears the sums, keeps the session alive for the window and watches for
+//! faults meanwhile: an actuator over its force limit (`OVER_FORCE`) stops the form as any
+//! fault does, and a node that reboots (its positions and limits lost) voids the reading.
 
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use firmware_protocol::NodeId;
 use firmware_protocol::actuator::MAX_ACTUATORS;
+use firmware_protocol::{Actuator, NodeId};
 use serde::Serialize;
 use tokio::time::Instant;
 
@@ -21,9 +22,8 @@ use super::transport::Transport;
 /// which divides the sensors' noise by 5.
 pub const DEFAULT_FORCE_WINDOW: Duration = Duration::from_millis(500);
 
-/// How often the window looks for fresh readings: the feedback period, so no reading of a
-/// node is missed and none is taken twice.
-const SAMPLE_PERIOD: Duration =
+/// How often the window looks for faults and reboots: a feedback period.
+const CHECK_PERIOD: Duration =
     Duration::from_millis(firmware_protocol::timing::FEEDBACK_PERIOD_MS as u64);
 
 /// One actuator's force over the window.
@@ -43,45 +43,54 @@ pub fn without_force<T: Transport>(session: &Session<T>) -> Vec<u8> {
 }
 
 /// Reads every actuator's force for `window`, keeping the session alive; warnings found on
-/// the way go to `warnings`. A fault meanwhile stops the form ([`Session::stop_for_fault`]).
-/// Actuators without a reading are left out.
+/// the way go to `warnings`. Every reading of the window counts once (each frame as it
+/// arrives). A fault meanwhile stops the form ([`Session::stop_for_fault`]); a node that
+/// reboots voids the reading ([`SessionError::RebootedWhileReading`]). Actuators without a
+/// reading are left out.
 pub async fn read_forces<T: Transport>(
     session: &mut Session<T>,
     window: Duration,
     warnings: &mut Vec<String>,
 ) -> Result<BTreeMap<String, ForceSample>, SessionError> {
-    let mut sums: BTreeMap<(NodeId, usize), (f64, f64, u32)> = BTreeMap::new();
-    let mut seen: BTreeMap<NodeId, u64> =
-        session.nodes().iter().map(|(&n, s)| (n, s.force_readings)).collect();
+    let nodes: Vec<NodeId> = session.nodes().keys().copied().collect();
+    for &node in &nodes {
+        if let Some(status) = session.node_mut(node) {
+            status.force_sums = Default::default();
+        }
+    }
     let end = Instant::now() + window;
     while Instant::now() < end {
-        let tick = (Instant::now() + SAMPLE_PERIOD).min(end);
+        let tick = (Instant::now() + CHECK_PERIOD).min(end);
         session.wait_until(tick, |_| false).await?;
         if let Some(fault) = session.fault(warnings).await? {
             return Err(session.stop_for_fault(fault).await);
         }
-        for (&node, status) in session.nodes() {
-            if seen.get(&node) == Some(&status.force_readings) {
-                continue;
-            }
-            seen.insert(node, status.force_readings);
-            for (index, force) in status.forces.iter().enumerate().take(MAX_ACTUATORS) {
-                if let Some(f) = force {
-                    let entry = sums.entry((node, index)).or_default();
-                    *entry = (entry.0 + f.n(), entry.1 + f.n() * f.n(), entry.2 + 1);
-                }
-            }
+        if let Some((&node, _)) = session.nodes().iter().find(|(_, s)| s.rebooted) {
+            let name = session.node_name(node).to_string();
+            session.halt_all().await?;
+            session.disable_all().await?;
+            return Err(SessionError::RebootedWhileReading(name));
         }
     }
     let form = session.form();
-    Ok(sums
-        .into_iter()
-        .filter_map(|((node, index), (sum, squares, count))| {
-            let axis = form.actuator_at(node, firmware_protocol::Actuator::new(index as u8)?)?;
-            let n = f64::from(count);
-            let mean = sum / n;
-            let sd = (squares / n - mean * mean).max(0.0).sqrt();
-            Some((axis.id.to_string(), ForceSample { mean_n: mean, sd_n: sd, readings: count }))
-        })
-        .collect())
+    let mut samples = BTreeMap::new();
+    for (&node, status) in session.nodes() {
+        for (index, sum) in status.force_sums.iter().enumerate().take(MAX_ACTUATORS) {
+            let Some(axis) = Actuator::new(index as u8).and_then(|a| form.actuator_at(node, a))
+            else {
+                continue;
+            };
+            if sum.count == 0 {
+                continue;
+            }
+            let n = f64::from(sum.count);
+            let mean = sum.sum / n;
+            let sd = (sum.squares / n - mean * mean).max(0.0).sqrt();
+            samples.insert(
+                axis.id.to_string(),
+                ForceSample { mean_n: mean, sd_n: sd, readings: sum.count },
+            );
+        }
+    }
+    Ok(samples)
 }

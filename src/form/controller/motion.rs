@@ -212,7 +212,7 @@ pub async fn run<T: Transport>(
 ) -> Result<(u64, Vec<ActuatorReport>, Vec<String>), MoveError> {
     let mut warnings = Vec::new();
     let mut reboots: BTreeMap<NodeId, usize> = BTreeMap::new();
-    let (duration, started) = sync(session, plan, options).await?;
+    let (duration, started) = sync(session, plan, options, &mut warnings).await?;
     let mut planned = Duration::from_millis(duration);
     let mut settled: BTreeMap<String, u64> = BTreeMap::new();
     loop {
@@ -254,7 +254,7 @@ pub async fn run<T: Transport>(
             session.wait_ready(&rebooted, homing_timeout).await?;
             let again: Vec<PlannedTarget> =
                 plan.iter().filter(|t| rebooted.contains(&t.node)).cloned().collect();
-            let (resumed, _) = sync(session, &again, options).await?;
+            let (resumed, _) = sync(session, &again, options, &mut warnings).await?;
             // The whole move is watched until the resumed part is done too.
             planned = planned.max(started.elapsed() + Duration::from_millis(resumed));
             continue;
@@ -283,11 +283,14 @@ pub async fn run<T: Transport>(
     Ok((duration, reports, warnings))
 }
 
-/// Stages and SYNCs `plan`; returns the duration (ms) and when the (last) SYNC went out.
+/// Stages and SYNCs `plan`; returns the duration (ms) and when the (last) SYNC went out. A
+/// fault found before the SYNC (latched since the last move, or while staging) stops the form
+/// instead: no node starts a move next to a faulty one.
 async fn sync<T: Transport>(
     session: &mut Session<T>,
     plan: &[PlannedTarget],
     options: &MoveOptions,
+    warnings: &mut Vec<String>,
 ) -> Result<(u64, Instant), MoveError> {
     let shortest = shortest_common_duration(session, plan);
     let slower = if options.slower.is_finite() { options.slower.max(1.0) } else { 1.0 };
@@ -320,6 +323,9 @@ async fn sync<T: Transport>(
         if pending.is_empty() {
             break;
         }
+    }
+    if let Some(fault) = session.fault(warnings).await? {
+        return Err(session.stop_for_fault(fault).await.into());
     }
     let mut sent = Instant::now();
     for _ in 0..=CONFIRM_RETRIES {

@@ -7,8 +7,9 @@
 //! [`COMFORT_LIMIT_KPA`] comfortable, up to [`TIGHT_ABOVE_KPA`] critical, above it too tight.
 //!
 //! **Compression** (RAL-GZ 387/1, medical compression hosiery, pressure at the ankle):
-//! class I 15-21 mmHg, II 23-32, III 34-46, IV 49 and over; a pressure between two classes is
-//! reported as such.
+//! class I 18-21 mmHg, II 23-32, III 34-46, IV 49 and over; a pressure between two classes is
+//! reported as such. (CEN's ENV 12718 starts class I at 15 mmHg; RAL's is the German quality
+//! mark the issue names.)
 
 use serde::Serialize;
 
@@ -24,12 +25,17 @@ pub const KPA_PER_MMHG: f64 = 0.133_322;
 
 /// RAL-GZ 387's compression classes, mmHg: lower and upper bounds (class IV has none).
 const RAL_CLASSES_MMHG: [(f64, f64); 4] =
-    [(15.0, 21.0), (23.0, 32.0), (34.0, 46.0), (49.0, f64::INFINITY)];
+    [(18.0, 21.0), (23.0, 32.0), (34.0, 46.0), (49.0, f64::INFINITY)];
 
-/// A ring's verdict.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
+/// Where a compression garment reaches class I, kPa: what a sweep looks for on one.
+pub const CLASS_I_FROM_KPA: f64 = RAL_CLASSES_MMHG[0].0 * KPA_PER_MMHG;
+
+/// A ring's verdict; in JSON the kebab-case of its words (`too-tight`, `class-ii`,
+/// `between-class-i-and-ii`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Verdict {
+    /// Some panel of the ring has no force reading: nothing can be said.
+    NotMeasured,
     /// The garment does not touch the ring.
     NoContact,
     /// Daily wear: loose, pressure negligible.
@@ -89,6 +95,7 @@ impl Verdict {
         let roman =
             |c: u8| ["I", "II", "III", "IV"].get(usize::from(c) - 1).copied().unwrap_or("?");
         match self {
+            Self::NotMeasured => "not measured".into(),
             Self::NoContact => "no contact".into(),
             Self::Loose => "loose".into(),
             Self::Comfortable => "comfortable".into(),
@@ -98,6 +105,12 @@ impl Verdict {
             Self::Class(c) => format!("class {}", roman(c)),
             Self::AboveClass(c) => format!("between class {} and {}", roman(c), roman(c + 1)),
         }
+    }
+}
+
+impl Serialize for Verdict {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(&self.words().to_lowercase().replace(' ', "-"))
     }
 }
 
@@ -119,10 +132,15 @@ mod tests {
     fn compression_falls_in_ral_classes() {
         let at = |mmhg: f64| Verdict::compression(mmhg * KPA_PER_MMHG, true);
         assert_eq!(at(10.0), Verdict::BelowClassI);
+        assert_eq!(at(17.0), Verdict::BelowClassI);
         assert_eq!(at(18.0), Verdict::Class(1));
         assert_eq!(at(22.0), Verdict::AboveClass(1));
         assert_eq!(at(30.0), Verdict::Class(2));
         assert_eq!(at(60.0), Verdict::Class(4));
         assert_eq!(Verdict::AboveClass(1).words(), "between class I and II");
+        let json = |v: Verdict| serde_json::to_value(v).unwrap();
+        assert_eq!(json(Verdict::AboveClass(1)), "between-class-i-and-ii");
+        assert_eq!(json(Verdict::TooTight), "too-tight");
+        assert_eq!(json(Verdict::Class(2)), "class-ii");
     }
 }

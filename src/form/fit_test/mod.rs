@@ -23,9 +23,10 @@ pub mod sweep;
 
 use std::collections::BTreeMap;
 
+use firmware_protocol::HUNDREDTHS_PER_N;
 use form_description::FormDescription;
 use form_description::garment::{GarmentKind, GarmentSpec};
-use form_description::skin::RingSkin;
+use form_description::skin::{KPA_PER_N_PER_MM2, RingSkin};
 use serde::Serialize;
 
 pub use comfort::Verdict;
@@ -36,16 +37,17 @@ use crate::form::controller::ForceSample;
 /// contact: 4 (a false contact once in 30,000 panels of pure noise).
 pub const CONTACT_STANDARD_ERRORS: f64 = 4.0;
 /// The smallest force that counts as contact, N: one step of the wire (0.01 N).
-const LEAST_CONTACT_N: f64 = 0.01;
-/// kPa per N/mm².
-const KPA_PER_N_PER_MM2: f64 = 1000.0;
+const LEAST_CONTACT_N: f64 = 1.0 / HUNDREDTHS_PER_N;
 
 /// One panel under the garment.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PanelPressure {
     /// Its actuator.
     pub actuator: String,
-    /// Its mean force along its actuator, N (what its sensor measures).
+    /// Its force was read (a node of protocol 1.1 with a sensor on it); without it the ring
+    /// is [`Verdict::NotMeasured`].
+    pub measured: bool,
+    /// Its mean force along its actuator, N (what its sensor measures; 0 unread).
     pub force_n: f64,
     /// The force the garment presses it with, N: the measured force over the part of the
     /// band's press its actuator carries ([`PanelGain`](form_description::skin::PanelGain)).
@@ -131,6 +133,7 @@ pub fn assess(
                 .zip(skin.gains())
                 .map(|((a, share_mm), gain)| {
                     let sample = forces.get(&a.id);
+                    let measured = sample.is_some();
                     let force_n = sample.map_or(0.0, |s| s.mean_n);
                     let noise = sample.map_or(0.0, |s| {
                         CONTACT_STANDARD_ERRORS * s.sd_n / f64::from(s.readings.max(1)).sqrt()
@@ -142,6 +145,7 @@ pub fn assess(
                         if contact { KPA_PER_N_PER_MM2 * normal_n / area } else { 0.0 };
                     PanelPressure {
                         actuator: a.id.clone(),
+                        measured,
                         force_n,
                         normal_n,
                         share_mm,
@@ -160,6 +164,7 @@ pub fn assess(
             let imbalance_n =
                 (panels.iter().map(|p| (p.force_n - mean_force).powi(2)).sum::<f64>() / n).sqrt();
             let verdict = match garment.kind {
+                _ if panels.iter().any(|p| !p.measured) => Verdict::NotMeasured,
                 GarmentKind::Daily => Verdict::daily(mean_pressure_kpa, contact),
                 GarmentKind::Compression => Verdict::compression(mean_pressure_kpa, contact),
             };

@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 use std::str::FromStr;
 
 use form_description::FormDescription;
-use form_description::garment::GarmentSpec;
+use form_description::garment::{GarmentKind, GarmentSpec};
 use form_description::skin::RingSkin;
 use serde::Serialize;
 
@@ -39,17 +39,26 @@ pub struct SweepRange {
 }
 
 impl SweepRange {
-    /// Every step, from `from_mm` up.
+    /// How many steps, as a float (a parsed range has at most [`MAX_STEPS`]).
+    fn count(&self) -> f64 {
+        ((self.to_mm - self.from_mm) / self.step_mm + 1e-9).floor() + 1.0
+    }
+
+    /// Every step, from `from_mm` up; 0 exactly when the range passes through it.
     pub fn deltas(&self) -> Vec<f64> {
-        let count = ((self.to_mm - self.from_mm) / self.step_mm + 1e-9).floor() as usize + 1;
-        (0..count).map(|k| self.from_mm + k as f64 * self.step_mm).collect()
+        let count = self.count().clamp(1.0, MAX_STEPS as f64) as usize;
+        (0..count)
+            .map(|k| self.from_mm + k as f64 * self.step_mm)
+            .map(|d| if d.abs() < 1e-9 * self.step_mm { 0.0 } else { d })
+            .collect()
     }
 }
 
 impl FromStr for SweepRange {
     type Err = String;
 
-    /// `FROM:TO:STEP` in mm, `FROM <= TO`, `STEP > 0`, at most [`MAX_STEPS`] steps.
+    /// `FROM:TO:STEP` in mm, `FROM <= 0 <= TO` (the customer's own girths are a step),
+    /// `STEP > 0`, at most [`MAX_STEPS`] steps.
     fn from_str(text: &str) -> Result<Self, String> {
         let parts: Vec<&str> = text.split(':').collect();
         let [from, to, step] = parts[..] else {
@@ -69,9 +78,16 @@ impl FromStr for SweepRange {
         if range.from_mm > range.to_mm {
             return Err(format!("`{text}`: FROM must not be above TO"));
         }
-        let steps = range.deltas().len();
-        if steps > MAX_STEPS {
-            return Err(format!("`{text}` takes {steps} steps; at most {MAX_STEPS}"));
+        if range.from_mm > 0.0 || range.to_mm < 0.0 {
+            return Err(format!("`{text}`: the range must include 0 (the customer's girths)"));
+        }
+        let steps = range.count();
+        // NaN (an infinite range over an infinite step) counts as too many.
+        if steps.is_nan() || steps > MAX_STEPS as f64 {
+            return Err(format!("`{text}` takes {steps:.0} steps; at most {MAX_STEPS}"));
+        }
+        if !range.deltas().contains(&0.0) {
+            return Err(format!("`{text}`: the steps must land on 0 (FROM a multiple of STEP)"));
         }
         Ok(range)
     }
@@ -86,6 +102,9 @@ pub fn step_setpoints(
     delta_mm: f64,
 ) -> SetPoints {
     let mut step = base.clone();
+    if delta_mm == 0.0 {
+        return step;
+    }
     for band in &garment.bands {
         let Some(skin) = RingSkin::of(form, &band.ring, &base.positions_mm) else { continue };
         let wanted = skin.girth_mm() + delta_mm;
@@ -127,7 +146,7 @@ pub struct SweepStep {
     pub fit: FitTest,
 }
 
-/// Where a ring's mean pressure crosses the comfort limit.
+/// Where a ring's mean pressure crosses the sweep's limit.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Crossing {
     /// The ring.
@@ -139,12 +158,16 @@ pub struct Crossing {
     pub delta_mm: f64,
     /// The first step at or over the limit, mm.
     pub step_delta_mm: f64,
+    /// The ring was over the limit from the sweep's first step: it crosses somewhere below.
+    pub from_start: bool,
 }
 
 /// What a sweep found.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Sweep {
-    /// The pressure a ring may not exceed, kPa.
+    /// The pressure a sweep looks for, kPa: the comfort limit for daily wear (where the
+    /// garment binds), class I's lower bound for a compression garment (where it starts to
+    /// compress).
     pub limit_kpa: f64,
     /// Every step, smallest first.
     pub steps: Vec<SweepStep>,
@@ -152,14 +175,38 @@ pub struct Sweep {
     pub crossings: Vec<Crossing>,
     /// The first ring to cross: where the garment starts to bind.
     pub binds: Option<Crossing>,
-    /// The steps where no ring is over the limit (the run nearest the customer's girths),
-    /// mm of offset: the garment's usable size range.
+    /// The steps where no ring is over the limit and every ring took its step's girth (the
+    /// run nearest the customer's girths), mm of offset: the garment's usable size range.
     pub usable_mm: Option<[f64; 2]>,
+    /// Steps where some ring could not take its girth (its panels at the ends of their
+    /// strokes), mm of offset: left out of the crossings and the usable range.
+    pub saturated_mm: Vec<f64>,
+}
+
+/// How far a ring's girth on the form may be off its step's before the step counts as out of
+/// the form's reach, mm: the girth tolerance a drive judges a shape by.
+const REACH_MM: f64 = crate::form::form_fit::DEFAULT_GIRTH_TOLERANCE_MM;
+
+/// Whether every ring of `fit` took its girth (within [`REACH_MM`]).
+fn reached(fit: &FitTest) -> bool {
+    fit.rings
+        .iter()
+        .all(|r| r.body_girth_mm.is_none_or(|b| (r.form_girth_mm - b).abs() <= REACH_MM))
+}
+
+/// The pressure a sweep of a garment of `kind` looks for ([`Sweep::limit_kpa`]).
+pub fn limit_for(kind: GarmentKind) -> f64 {
+    match kind {
+        GarmentKind::Daily => super::comfort::COMFORT_LIMIT_KPA,
+        GarmentKind::Compression => super::comfort::CLASS_I_FROM_KPA,
+    }
 }
 
 /// Finds the crossings, the binding ring and the usable range of `steps` (smallest first)
 /// against `limit_kpa`.
 pub fn analyse(steps: Vec<SweepStep>, limit_kpa: f64) -> Sweep {
+    let saturated_mm: Vec<f64> =
+        steps.iter().filter(|s| !reached(&s.fit)).map(|s| s.delta_mm).collect();
     let rings: Vec<String> = steps
         .first()
         .map(|s| s.fit.rings.iter().map(|r| r.ring.clone()).collect())
@@ -168,6 +215,7 @@ pub fn analyse(steps: Vec<SweepStep>, limit_kpa: f64) -> Sweep {
     for ring in &rings {
         let curve: Vec<(f64, f64, f64)> = steps
             .iter()
+            .filter(|s| reached(&s.fit))
             .filter_map(|s| {
                 let r = s.fit.rings.iter().find(|r| &r.ring == ring)?;
                 Some((s.delta_mm, r.form_girth_mm, r.mean_pressure_kpa))
@@ -182,12 +230,18 @@ pub fn analyse(steps: Vec<SweepStep>, limit_kpa: f64) -> Sweep {
             }
             _ => (girth_k, delta_k),
         };
-        crossings.push(Crossing { ring: ring.clone(), girth_mm, delta_mm, step_delta_mm: delta_k });
+        crossings.push(Crossing {
+            ring: ring.clone(),
+            girth_mm,
+            delta_mm,
+            step_delta_mm: delta_k,
+            from_start: k == 0,
+        });
     }
     let binds = crossings.iter().min_by(|a, b| a.delta_mm.total_cmp(&b.delta_mm)).cloned();
     let ok: Vec<bool> = steps
         .iter()
-        .map(|s| s.fit.rings.iter().all(|r| r.mean_pressure_kpa <= limit_kpa))
+        .map(|s| reached(&s.fit) && s.fit.rings.iter().all(|r| r.mean_pressure_kpa <= limit_kpa))
         .collect();
     let mut runs: Vec<(usize, usize)> = Vec::new();
     for (k, &fine) in ok.iter().enumerate() {
@@ -205,7 +259,7 @@ pub fn analyse(steps: Vec<SweepStep>, limit_kpa: f64) -> Sweep {
         .iter()
         .min_by(|a, b| distance(a).total_cmp(&distance(b)))
         .map(|&(a, b)| [steps[a].delta_mm, steps[b].delta_mm]);
-    Sweep { limit_kpa, steps, crossings, binds, usable_mm }
+    Sweep { limit_kpa, steps, crossings, binds, usable_mm, saturated_mm }
 }
 
 /// The sweep as a table: pressure per ring and step, then the crossings.
@@ -235,10 +289,26 @@ pub fn table(sweep: &Sweep) -> String {
         "  (each ring's girth on the form, mm, and mean pressure, kPa, at each step's offset)"
     );
     for c in &sweep.crossings {
+        if c.from_start {
+            let _ = writeln!(
+                s,
+                "  {} is over {:.2} kPa from the first step ({:.1} mm)",
+                c.ring, sweep.limit_kpa, c.girth_mm
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "  {} crosses {:.2} kPa at {:.1} mm ({:+.1} mm; first step over: {:+.1})",
+                c.ring, sweep.limit_kpa, c.girth_mm, c.delta_mm, c.step_delta_mm
+            );
+        }
+    }
+    if !sweep.saturated_mm.is_empty() {
+        let steps: Vec<String> = sweep.saturated_mm.iter().map(|d| format!("{d:+.0}")).collect();
         let _ = writeln!(
             s,
-            "  {} crosses {} kPa at {:.1} mm ({:+.1} mm; first step over: {:+.1})",
-            c.ring, sweep.limit_kpa, c.girth_mm, c.delta_mm, c.step_delta_mm
+            "  beyond the form's reach (a ring at the ends of its strokes) at {} mm: left out",
+            steps.join(", ")
         );
     }
     match &sweep.binds {
@@ -271,6 +341,10 @@ mod tests {
         assert_eq!(r.deltas()[0], -40.0);
         assert_eq!(*r.deltas().last().unwrap(), 40.0);
         assert!("1:0:1".parse::<SweepRange>().unwrap_err().contains("FROM must not"));
+        assert!("10:20:5".parse::<SweepRange>().unwrap_err().contains("include 0"));
+        assert!("-7:10:5".parse::<SweepRange>().unwrap_err().contains("land on 0"));
+        assert!("0:1e12:1".parse::<SweepRange>().unwrap_err().contains("at most"));
+        assert!("-1e308:1e308:1".parse::<SweepRange>().unwrap_err().contains("at most"));
         assert!("0:10:0".parse::<SweepRange>().unwrap_err().contains("above 0"));
         assert!("0:1000:1".parse::<SweepRange>().unwrap_err().contains("at most"));
         assert!("a:1:1".parse::<SweepRange>().unwrap_err().contains("not a number"));

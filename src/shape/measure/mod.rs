@@ -44,7 +44,7 @@ pub use neck_and_shoulders::{
     MIDLINE_BAND_MM, NeckAndShoulders, PlaneMeasure, across_back_and_front, neck_and_shoulders,
 };
 pub use plane::{PlaneLoop, tape_arc};
-pub use plausibility::{MAX_SIDE_DIFFERENCE, Unreliable, WRIST_GIRTH_MM, hold_back};
+pub use plausibility::{LIMITS, MAX_SIDE_DIFFERENCE, Unreliable, WRIST_GIRTH_MM, hold_back, limit};
 pub use scan_report::{MeasureReport, measure_scan};
 
 use crate::body::mesh::Mesh;

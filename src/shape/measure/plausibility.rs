@@ -15,6 +15,45 @@ use super::{Bilateral, BodyDimensions};
 /// well inside it; a section through the hand or the forearm's end leaves it).
 pub const WRIST_GIRTH_MM: RangeInclusive<f64> = 100.0..=250.0;
 
+/// The plausible range of every other measurement (mm; degrees for the shoulder slope), by
+/// its name in the report's JSON. Envelopes, deliberately wide: each lies well outside the
+/// adult extremes of anthropometric surveys (ANSUR II, 2012: statures 1.41-2.05 m; its
+/// girths, breadths and lengths scale with it) and of the customers this tool is for, so a
+/// value outside is not an unusual body but a wrong section (a limb cut with the torso, a
+/// level missed): it is held back, never printed as a number.
+pub const LIMITS: [(&str, RangeInclusive<f64>); 22] = [
+    ("stature_mm", 1200.0..=2300.0),
+    ("neck_girth_mm", 250.0..=600.0),
+    ("neck_base_girth_mm", 300.0..=700.0),
+    ("shoulder_width_mm", 250.0..=550.0),
+    ("across_shoulder_mm", 300.0..=750.0),
+    ("across_back_mm", 200.0..=600.0),
+    ("across_front_mm", 200.0..=600.0),
+    ("shoulder_slope_deg", 0.0..=45.0),
+    ("chest_girth_mm", 600.0..=1800.0),
+    ("underbust_girth_mm", 550.0..=1700.0),
+    ("waist_girth_mm", 500.0..=1800.0),
+    ("high_hip_girth_mm", 600.0..=1900.0),
+    ("hip_girth_mm", 700.0..=1900.0),
+    ("thigh_girth_mm", 300.0..=1000.0),
+    ("knee_girth_mm", 250.0..=650.0),
+    ("calf_girth_mm", 220.0..=650.0),
+    ("ankle_girth_mm", 160.0..=400.0),
+    ("upper_arm_girth_mm", 180.0..=650.0),
+    ("arm_length_mm", 450.0..=900.0),
+    ("inside_leg_mm", 550.0..=1150.0),
+    ("back_waist_length_mm", 300.0..=650.0),
+    ("front_waist_length_mm", 250.0..=650.0),
+];
+
+/// The range of `name` in [`LIMITS`] (the wrist's is [`WRIST_GIRTH_MM`]).
+pub fn limit(name: &str) -> Option<&'static RangeInclusive<f64>> {
+    if name == "wrist_girth_mm" {
+        return Some(&WRIST_GIRTH_MM);
+    }
+    LIMITS.iter().find(|(n, _)| *n == name).map(|(_, range)| range)
+}
+
 /// The most the two sides of one body differ, relative to their mean: 20% (issue 33's
 /// limit); a body's left and right girths and lengths differ by a few percent.
 pub const MAX_SIDE_DIFFERENCE: f64 = 0.20;
@@ -36,11 +75,49 @@ impl std::fmt::Display for Unreliable {
     }
 }
 
-/// Holds back every measurement of `d` outside its limit (set to NaN), and returns each with
-/// its reason.
+/// Holds back every measurement of `d` outside its limit ([`LIMITS`], [`WRIST_GIRTH_MM`]) or
+/// whose sides differ by more than [`MAX_SIDE_DIFFERENCE`] (set to NaN), and returns each with
+/// its reason. The waist and hip heights are not judged here: their levels' rules place them
+/// between the crotch and the armpits.
 pub fn hold_back(d: &mut BodyDimensions) -> Vec<Unreliable> {
     let mut held = Vec::new();
-    range("wrist_girth_mm", &mut d.wrist_girth_mm, &WRIST_GIRTH_MM, &mut held);
+    let scalars: [(&str, &mut f64); 15] = [
+        ("stature_mm", &mut d.stature_mm),
+        ("neck_girth_mm", &mut d.neck_girth_mm),
+        ("neck_base_girth_mm", &mut d.neck_base_girth_mm),
+        ("shoulder_width_mm", &mut d.shoulder_width_mm),
+        ("across_shoulder_mm", &mut d.across_shoulder_mm),
+        ("across_back_mm", &mut d.across_back_mm),
+        ("across_front_mm", &mut d.across_front_mm),
+        ("chest_girth_mm", &mut d.chest_girth_mm),
+        ("underbust_girth_mm", &mut d.underbust_girth_mm),
+        ("waist_girth_mm", &mut d.waist_girth_mm),
+        ("high_hip_girth_mm", &mut d.high_hip_girth_mm),
+        ("hip_girth_mm", &mut d.hip_girth_mm),
+        ("inside_leg_mm", &mut d.inside_leg_mm),
+        ("back_waist_length_mm", &mut d.back_waist_length_mm),
+        ("front_waist_length_mm", &mut d.front_waist_length_mm),
+    ];
+    for (name, value) in scalars {
+        if let Some(limit) = limit(name) {
+            scalar(name, value, limit, &mut held);
+        }
+    }
+    let ranged: [(&str, &mut Bilateral); 8] = [
+        ("shoulder_slope_deg", &mut d.shoulder_slope_deg),
+        ("thigh_girth_mm", &mut d.thigh_girth_mm),
+        ("knee_girth_mm", &mut d.knee_girth_mm),
+        ("calf_girth_mm", &mut d.calf_girth_mm),
+        ("ankle_girth_mm", &mut d.ankle_girth_mm),
+        ("upper_arm_girth_mm", &mut d.upper_arm_girth_mm),
+        ("wrist_girth_mm", &mut d.wrist_girth_mm),
+        ("arm_length_mm", &mut d.arm_length_mm),
+    ];
+    for (name, pair) in ranged {
+        if let Some(limit) = limit(name) {
+            range(name, pair, limit, &mut held);
+        }
+    }
     let sides: [(&str, &mut Bilateral); 7] = [
         ("thigh_girth_mm", &mut d.thigh_girth_mm),
         ("knee_girth_mm", &mut d.knee_girth_mm),
@@ -56,6 +133,28 @@ pub fn hold_back(d: &mut BodyDimensions) -> Vec<Unreliable> {
     held
 }
 
+/// `value` held back when outside `limit`.
+fn scalar(name: &str, value: &mut f64, limit: &RangeInclusive<f64>, held: &mut Vec<Unreliable>) {
+    if value.is_finite() && !limit.contains(value) {
+        held.push(Unreliable {
+            measurement: name.to_string(),
+            value: *value,
+            reason: outside(limit),
+        });
+        *value = f64::NAN;
+    }
+}
+
+/// Why a value outside `limit` is held back.
+fn outside(limit: &RangeInclusive<f64>) -> String {
+    format!(
+        "outside {:.0}-{:.0}, an adult's range (the section may cut a limb with the torso, or \
+         miss its level: a posed body; `reconstruct` re-poses the scan)",
+        limit.start(),
+        limit.end()
+    )
+}
+
 /// Each side of `pair` outside `limit`, held back.
 fn range(
     name: &str,
@@ -68,12 +167,7 @@ fn range(
             held.push(Unreliable {
                 measurement: format!("{name}.{side}"),
                 value: *value,
-                reason: format!(
-                    "outside {:.0}-{:.0} mm, an adult's range (the section may cut the hand or \
-                     the torso: a posed arm; `reconstruct` re-poses the scan)",
-                    limit.start(),
-                    limit.end()
-                ),
+                reason: outside(limit),
             });
             *value = f64::NAN;
         }
@@ -126,7 +220,7 @@ mod tests {
         assert!(wrist.right.is_nan() && wrist.difference.is_nan());
         assert_eq!(held.len(), 1);
         assert_eq!(held[0].measurement, "wrist_girth_mm.right");
-        assert!(held[0].to_string().contains("57.7: outside 100-250 mm"), "{}", held[0]);
+        assert!(held[0].to_string().contains("57.7: outside 100-250"), "{}", held[0]);
         // The remaining side alone is not compared.
         alike("wrist_girth_mm", &mut wrist, &mut held);
         assert_eq!((held.len(), wrist.left), (1, 203.3));

@@ -3,31 +3,32 @@
 use std::collections::BTreeMap;
 
 use form_description::FormDescription;
-use form_description::skin::RingSkin;
+use form_description::skin::{KPA_PER_N_PER_MM2, RingSkin};
 
 use super::BandSpec;
 
 /// Millimetres per metre: tensions are per metre of band width, widths in mm.
 const MM_PER_M: f64 = 1000.0;
-/// kPa per N/mm².
-const KPA_PER_N_PER_MM2: f64 = 1000.0;
 
 /// What one panel carries.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PanelLoad {
     /// Its actuator.
     pub actuator: String,
-    /// The force pressing it inwards along its actuator, N.
+    /// The force pressing it inwards along its actuator, N: what its sensor reads.
     pub force_n: f64,
+    /// The whole press of the band on it, N (the part across its actuator goes into its
+    /// guides).
+    pub normal_n: f64,
     /// Its share of the band: half of each skin edge at its ends times the band's width, mm²
     /// (0 for a panel under its neighbours' skin, which the band does not touch).
     pub area_mm2: f64,
 }
 
 impl PanelLoad {
-    /// The contact pressure, kPa: the force over the panel's share of the band.
+    /// The contact pressure, kPa: the press over the panel's share of the band.
     pub fn pressure_kpa(&self) -> f64 {
-        if self.area_mm2 > 0.0 { KPA_PER_N_PER_MM2 * self.force_n / self.area_mm2 } else { 0.0 }
+        if self.area_mm2 > 0.0 { KPA_PER_N_PER_MM2 * self.normal_n / self.area_mm2 } else { 0.0 }
     }
 }
 
@@ -51,10 +52,10 @@ pub struct BandLoad {
 }
 
 impl BandLoad {
-    /// The mean pressure over the band, kPa: every panel's force over the band's area (the
-    /// skin's girth times its width); on a round ring Laplace's `2π T / C`.
+    /// The mean pressure over the band, kPa: its whole press over the band's area (the skin's
+    /// girth times its width); Laplace's `2π T / C` on the panel polygon.
     pub fn mean_pressure_kpa(&self) -> f64 {
-        let force: f64 = self.panels.iter().map(|p| p.force_n).sum();
+        let force: f64 = self.panels.iter().map(|p| p.normal_n).sum();
         KPA_PER_N_PER_MM2 * force / (self.skin_girth_mm * self.width_mm)
     }
 }
@@ -80,11 +81,13 @@ pub fn band_load(
         .map(|(a, share)| PanelLoad {
             actuator: a.id.clone(),
             force_n: 0.0,
+            normal_n: 0.0,
             area_mm2: share * band.width_mm,
         })
         .collect();
     for (panel, gain) in panels.iter_mut().zip(skin.gains()) {
         panel.force_n = tension_n_per_m * width_m * gain.axial;
+        panel.normal_n = tension_n_per_m * width_m * gain.normal;
     }
     Some(BandLoad {
         ring: band.ring.clone(),

@@ -419,7 +419,7 @@ impl Node {
             let noise = clipped(&self.noise, self.config.noise_mm, &mut self.rng);
             *slot = actuator.measured(now, noise);
         }
-        let halves = all.half(Half::Lower).positions.len() < self.actuators.len();
+        let halves = self.actuators.len() > MAX_ACTUATORS / 2;
         match self.config.link {
             Link::ClassicCan => {
                 self.send(Message::Feedback(all.half(Half::Lower)));
@@ -447,7 +447,7 @@ impl Node {
             let noise = clipped(&self.force_noise, self.config.force_noise_n, &mut self.rng);
             *slot = actuator.measured_force(noise);
         }
-        let halves = all.half(Half::Lower).forces.len() < self.actuators.len();
+        let halves = self.actuators.len() > MAX_ACTUATORS / 2;
         match self.config.link {
             Link::ClassicCan => {
                 self.send(Message::Force(all.half(Half::Lower)));

@@ -79,8 +79,10 @@ pub struct SimOptions {
 /// them.
 pub const RATED_FORCE_N: f64 = 100.0;
 
-/// The simulated force sensors' noise, N (one standard deviation): 0.1% of the rated force,
-/// the combined error of a C3-class load cell (OIML R 60's 3000 divisions).
+/// The simulated force sensors' noise, N (one standard deviation): 0.1% of the rated force, a
+/// deliberately pessimistic figure (a C3-class load cell, OIML R 60's 3000 divisions, errs
+/// by a few hundredths of a percent of its capacity), so the fit test's averaging and contact
+/// rule are exercised.
 pub const FORCE_NOISE_N: f64 = 0.1;
 
 impl Default for SimOptions {

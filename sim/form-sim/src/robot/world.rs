@@ -48,10 +48,23 @@ pub(crate) async fn run(
 ) {
     let mut ticker = interval(tick);
     ticker.set_missed_tick_behavior(MissedTickBehavior::Delay);
+    // Whether the loads are zero and no garment is worn.
+    let mut bare = false;
     loop {
         ticker.tick().await;
         let now = Instant::now();
-        let worn = lock(&garment).clone();
+        let Some(worn) = lock(&garment).clone() else {
+            // Nothing worn: the loads are zero once, then nothing to do.
+            if !bare {
+                for node in &nodes {
+                    let mut sim = lock(node);
+                    Actuator::all().for_each(|index| sim.node.apply_load(index, 0.0));
+                }
+                bare = true;
+            }
+            continue;
+        };
+        bare = false;
         let mut positions = BTreeMap::new();
         for node in &nodes {
             let sim = lock(node);
@@ -62,7 +75,7 @@ pub(crate) async fn run(
                 }
             }
         }
-        let loads = worn.map(|g| loads(&form, &g, &positions)).unwrap_or_default();
+        let loads = loads(&form, &worn, &positions);
         for node in &nodes {
             let mut sim = lock(node);
             let id = sim.node.id();

@@ -9,9 +9,9 @@
 use std::time::Duration;
 
 use firmware_protocol::drive::{AckStatus, DriveCommand, DriveState};
-use firmware_protocol::message::{Heartbeat, Param};
+use firmware_protocol::message::{Ack, Heartbeat, Param, ParamRead};
 use firmware_protocol::param::ParamId;
-use firmware_protocol::{Actuator, ActuatorSet, Message, NodeId, PROTOCOL_VERSION, Packet};
+use firmware_protocol::{Actuator, ActuatorSet, Force, HUNDREDTHS_PER_N, Message, NodeId, Packet};
 use tokio::time::Instant;
 
 use super::requests::ATTEMPTS;
@@ -35,6 +35,11 @@ impl<T: Transport> Session<T> {
     /// reboots, so every enable sets them). Does not wait for homing to finish.
     pub async fn enable(&mut self, node: NodeId) -> Result<(), SessionError> {
         self.set_force_limits(node).await?;
+        self.enable_and_home(node).await
+    }
+
+    /// Enables `node` and starts homing what needs it (its force limits already set).
+    async fn enable_and_home(&mut self, node: NodeId) -> Result<(), SessionError> {
         // A recent host heartbeat first: nodes refuse Enable without one (InvalidState), so
         // after a lost heartbeat, another heartbeat and another try.
         let mut attempts = 1;
@@ -68,35 +73,55 @@ impl<T: Transport> Session<T> {
 
     /// Whether `node` measures force: it speaks protocol 1.1 or later (from its identity).
     pub fn measures_force(&self, node: NodeId) -> bool {
-        self.nodes
-            .get(&node)
-            .and_then(|s| s.identity)
-            .is_some_and(|i| i.protocol.has_force() && PROTOCOL_VERSION.has_force())
+        self.nodes.get(&node).and_then(|s| s.identity).is_some_and(|i| i.protocol.has_force())
     }
 
     /// Writes the description's force limits to `node`'s actuators, if it measures force:
-    /// one `ParamWrite` for the whole node when they agree (the reference form's do), else
-    /// one per actuator.
+    /// one `ParamWrite` for the whole node when every actuator has the same (the reference
+    /// form's panel nodes), else one per actuator that has one (a lift without one keeps the
+    /// node's own, its rated force). A limit the node refuses is named with the actuator's
+    /// rated force.
     async fn set_force_limits(&mut self, node: NodeId) -> Result<(), SessionError> {
         if !self.measures_force(node) {
             return Ok(());
         }
-        let limits: Vec<(Option<Actuator>, i32)> = self
-            .form
-            .actuators_of(node)
-            .iter()
-            .map(|a| (a.actuator(), i32::from(a.force_limit().hundredths_n())))
-            .collect();
-        let writes = match limits.first() {
-            Some(&(_, first)) if limits.iter().all(|&(_, l)| l == first) => vec![(None, first)],
-            _ => limits,
+        let axes = self.form.actuators_of(node);
+        let limits: Vec<(Option<Actuator>, Option<Force>)> =
+            axes.iter().map(|a| (a.actuator(), a.force_limit())).collect();
+        let writes: Vec<(Option<Actuator>, Force)> = match limits.first() {
+            Some(&(_, Some(first))) if limits.iter().all(|&(_, l)| l == Some(first)) => {
+                vec![(None, first)]
+            }
+            _ => limits.iter().filter_map(|&(a, l)| Some((a, l?))).collect(),
         };
-        for (actuator, value) in writes {
+        for (actuator, limit) in writes {
+            let value = i32::from(limit.hundredths_n());
             let write = Param { param: ParamId::FORCE_LIMIT, actuator, value };
             let answer = self.request(Packet::node(node, Message::ParamWrite(write))).await?;
+            if let Message::Ack(Ack { status: AckStatus::InvalidArgument, .. }) = answer {
+                let rated = self.rated_force(node, actuator.or(limits[0].0)).await?;
+                return Err(SessionError::ForceLimit {
+                    node: self.node_name(node).to_string(),
+                    limit_n: limit.n(),
+                    rated_n: rated,
+                });
+            }
             self.expect_ok(node, "ParamWrite ForceLimit", answer).await?;
         }
         Ok(())
+    }
+
+    /// The rated force of `actuator` of `node`, N, if it answers.
+    async fn rated_force(
+        &mut self,
+        node: NodeId,
+        actuator: Option<Actuator>,
+    ) -> Result<Option<f64>, SessionError> {
+        let read = ParamRead { param: ParamId::RATED_FORCE, actuator };
+        Ok(match self.request(Packet::node(node, Message::ParamRead(read))).await? {
+            Message::ParamValue(p) => Some(f64::from(p.value) / HUNDREDTHS_PER_N),
+            _ => None,
+        })
     }
 
     /// Whether every actuator of `node` is homed, its position reported, and the node
@@ -110,11 +135,27 @@ impl<T: Transport> Session<T> {
         })
     }
 
-    /// Enables every node, homes what needs it, and waits until all are ready.
+    /// Enables every node, homes what needs it, and waits until all are ready. Every node's
+    /// force limits are set before any node is enabled; a node that fails or faults while
+    /// the others are being enabled stops them all (Halt, then each disabled), the fault
+    /// named as during a move.
     pub async fn enable_all(&mut self, homing_timeout: Duration) -> Result<(), SessionError> {
         let nodes: Vec<NodeId> = self.nodes.keys().copied().collect();
         for &node in &nodes {
-            self.enable(node).await?;
+            self.set_force_limits(node).await?;
+        }
+        for &node in &nodes {
+            if let Err(e) = self.enable_and_home(node).await {
+                let mut warnings = Vec::new();
+                return Err(match self.fault(&mut warnings).await {
+                    Ok(Some(fault)) => self.stop_for_fault(fault).await,
+                    Ok(None) => match self.halt_all().await {
+                        Ok(()) => self.disable_all().await.err().unwrap_or(e),
+                        Err(stopped) => stopped,
+                    },
+                    Err(failed) => failed,
+                });
+            }
         }
         self.wait_ready(&nodes, homing_timeout).await
     }

@@ -20,6 +20,21 @@ pub enum SessionError {
     /// The nodes do not match the description.
     #[error("the form does not match its description:\n  {}", list(.0))]
     Discovery(Vec<NodeProblem>),
+    /// A node refused the force limit the description sets (above its actuators' rated
+    /// force); nothing was enabled.
+    #[error("{node}: refused the force limit of {limit_n} N{}: lower `force_limit_n` in the form description", .rated_n.map_or(String::new(), |r| format!(", above its rated force of {r} N")))]
+    ForceLimit {
+        /// The node, by name.
+        node: String,
+        /// The limit asked for, N.
+        limit_n: f64,
+        /// The actuator's rated force, N, if the node said.
+        rated_n: Option<f64>,
+    },
+    /// Forces were being read and a node rebooted: the reading is void (its actuators'
+    /// positions and limits were lost).
+    #[error("{0} rebooted while the forces were read: the reading is void; test again")]
+    RebootedWhileReading(String),
     /// A node refused a request.
     #[error("node {node}: {request} refused: {}{hint}", faults::refusal_words(*.status))]
     Refused {

@@ -7,12 +7,14 @@
 //! `docs/controller-and-safety.md` and the host's side of "Faults and emergency events" in
 //! `firmware-protocol/README.md` (an unknown code is a fault only when the node is in Fault).
 
+use std::collections::BTreeSet;
 use std::time::Duration;
 
 use firmware_protocol::drive::{DriveCommand, DriveState, EmergencyCode, Faults};
-use firmware_protocol::{Message, NodeId, Packet, timing};
+use firmware_protocol::{Address, Code, Link, Message, NodeId, Packet, timing};
 use tokio::time::Instant;
 
+use super::requests::answer_timeout;
 use super::{Session, SessionError};
 use crate::form::controller::faults::{self, Fault, NodeName};
 use crate::form::controller::transport::Transport;
@@ -195,8 +197,26 @@ impl<T: Transport> Session<T> {
         }
     }
 
-    /// Broadcasts `Halt`: every node stops its moves and homing, and stays Enabled.
+    /// Broadcasts `Halt`: every node stops its moves and homing, and stays Enabled. On CAN
+    /// every node answers a broadcast with an `Ack` naming `Control`; those answers are taken
+    /// here (for at most an answer's time), so that none is taken later for the answer to a
+    /// `Control` sent to one node (a `Disable` that has not reached it yet).
     pub async fn halt_all(&mut self) -> Result<(), SessionError> {
-        self.send(Packet::broadcast(Message::Control(DriveCommand::Halt))).await
+        self.send(Packet::broadcast(Message::Control(DriveCommand::Halt))).await?;
+        if self.link() == Link::Serial {
+            return Ok(());
+        }
+        let mut waiting: BTreeSet<NodeId> = self.nodes.keys().copied().collect();
+        let deadline = Instant::now() + answer_timeout(self.link());
+        self.receive_until(deadline, |p| {
+            if let (Address::Node(node), Message::Ack(ack)) = (p.address, p.message)
+                && ack.request == Code::Control
+            {
+                waiting.remove(&node);
+            }
+            waiting.is_empty()
+        })
+        .await?;
+        Ok(())
     }
 }

@@ -36,9 +36,7 @@ use std::time::Duration;
 
 use firmware_protocol::actuator::MAX_ACTUATORS;
 use firmware_protocol::drive::DriveState;
-use firmware_protocol::message::{
-    Capabilities, Emergency, Forces8, Heartbeat, Identity, Positions8,
-};
+use firmware_protocol::message::{Capabilities, Emergency, Heartbeat, Identity, Positions8};
 use firmware_protocol::{Address, Force, Link, Message, NodeId, Packet, Position};
 use form_description::FormDescription;
 use tokio::sync::watch;
@@ -72,9 +70,9 @@ pub struct NodeStatus {
     pub positions: [Option<Position>; MAX_ACTUATORS],
     /// Its actuators' last measured forces (protocol 1.1; `None`: not measured).
     pub forces: [Option<Force>; MAX_ACTUATORS],
-    /// How many force readings it has sent (a classic CAN frame's half counts), so a reader
-    /// can wait for fresh ones.
-    pub force_readings: u64,
+    /// Every force reading of each actuator since the sums were last cleared (see
+    /// `controller::forces`): each frame's readings counted once.
+    pub force_sums: [ForceSum; MAX_ACTUATORS],
     /// When it was last heard from, in the session's listening time.
     pub heard: Option<Duration>,
     /// The link's stalls excused up to then (see [`Session::excused`]): later stalls are
@@ -86,6 +84,27 @@ pub struct NodeStatus {
     pub events: Vec<Emergency>,
     /// It fell back to Disabled with its homes forgotten since this was last cleared.
     pub rebooted: bool,
+}
+
+/// The sum of an actuator's force readings, N, to average them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ForceSum {
+    /// The readings' sum.
+    pub sum: f64,
+    /// Their squares' sum.
+    pub squares: f64,
+    /// How many.
+    pub count: u32,
+}
+
+impl ForceSum {
+    fn add(&mut self, force: Option<Force>) {
+        if let Some(f) = force {
+            self.sum += f.n();
+            self.squares += f.n() * f.n();
+            self.count += 1;
+        }
+    }
 }
 
 /// A session with the nodes of one form over one link.
@@ -227,14 +246,17 @@ impl<T: Transport> Session<T> {
             }
             Message::AllFeedback(all) => status.positions = all.positions,
             Message::Force(four) => {
-                let mut all = Forces8 { forces: status.forces };
-                all.set_half(&four);
-                status.forces = all.forces;
-                status.force_readings += 1;
+                let first = four.half.first();
+                for (k, force) in four.forces.iter().enumerate() {
+                    status.forces[first + k] = *force;
+                    status.force_sums[first + k].add(*force);
+                }
             }
             Message::AllForce(all) => {
-                status.forces = all.forces;
-                status.force_readings += 1;
+                for (k, force) in all.forces.iter().enumerate() {
+                    status.forces[k] = *force;
+                    status.force_sums[k].add(*force);
+                }
             }
             Message::Emergency(e) => status.events.push(e),
             Message::Identity(i) => status.identity = Some(i),
