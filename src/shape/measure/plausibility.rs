@@ -103,31 +103,23 @@ pub fn hold_back(d: &mut BodyDimensions) -> Vec<Unreliable> {
             scalar(name, value, limit, &mut held);
         }
     }
-    let ranged: [(&str, &mut Bilateral); 8] = [
-        ("shoulder_slope_deg", &mut d.shoulder_slope_deg),
-        ("thigh_girth_mm", &mut d.thigh_girth_mm),
-        ("knee_girth_mm", &mut d.knee_girth_mm),
-        ("calf_girth_mm", &mut d.calf_girth_mm),
-        ("ankle_girth_mm", &mut d.ankle_girth_mm),
-        ("upper_arm_girth_mm", &mut d.upper_arm_girth_mm),
-        ("wrist_girth_mm", &mut d.wrist_girth_mm),
-        ("arm_length_mm", &mut d.arm_length_mm),
+    // Each pair with whether its sides are compared (a shoulder slope's sides may differ).
+    let mut pairs: [(&str, &mut Bilateral, bool); 8] = [
+        ("shoulder_slope_deg", &mut d.shoulder_slope_deg, false),
+        ("thigh_girth_mm", &mut d.thigh_girth_mm, true),
+        ("knee_girth_mm", &mut d.knee_girth_mm, true),
+        ("calf_girth_mm", &mut d.calf_girth_mm, true),
+        ("ankle_girth_mm", &mut d.ankle_girth_mm, true),
+        ("upper_arm_girth_mm", &mut d.upper_arm_girth_mm, true),
+        ("wrist_girth_mm", &mut d.wrist_girth_mm, true),
+        ("arm_length_mm", &mut d.arm_length_mm, true),
     ];
-    for (name, pair) in ranged {
+    for (name, pair, _) in pairs.iter_mut() {
         if let Some(limit) = limit(name) {
             range(name, pair, limit, &mut held);
         }
     }
-    let sides: [(&str, &mut Bilateral); 7] = [
-        ("thigh_girth_mm", &mut d.thigh_girth_mm),
-        ("knee_girth_mm", &mut d.knee_girth_mm),
-        ("calf_girth_mm", &mut d.calf_girth_mm),
-        ("ankle_girth_mm", &mut d.ankle_girth_mm),
-        ("upper_arm_girth_mm", &mut d.upper_arm_girth_mm),
-        ("wrist_girth_mm", &mut d.wrist_girth_mm),
-        ("arm_length_mm", &mut d.arm_length_mm),
-    ];
-    for (name, pair) in sides {
+    for (name, pair, _) in pairs.iter_mut().filter(|(_, _, sides)| *sides) {
         alike(name, pair, &mut held);
     }
     held
