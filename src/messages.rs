@@ -5,8 +5,10 @@
 
 use std::fmt::Display;
 
-/// The longest line a message may have (characters): two lines of a terminal.
-pub const MAX_LINE: usize = 200;
+/// The longest line a message may have (characters): four lines of a terminal, room for a
+/// long path, what was seen and what to do (a measurement held back and why, a stance and the
+/// command that takes it); anything longer is an echo of a file's content, cut.
+pub const MAX_LINE: usize = 400;
 
 /// The most lines one message may have ("one line per problem"; more are summarised).
 pub const MAX_LINES: usize = 20;
@@ -175,7 +177,7 @@ mod tests {
         let b = bounded(&format!("first\u{1b}]0;title\u{7}\n{long}"));
         let lines: Vec<&str> = b.lines().collect();
         assert_eq!(lines[0], "first\\u{1b}]0;title\\u{7}");
-        assert!(lines[1].len() < MAX_LINE + 40 && lines[1].ends_with("(9800 more characters)"));
+        assert!(lines[1].len() < MAX_LINE + 40 && lines[1].ends_with("(9600 more characters)"));
         let many = (0..100).map(|i| i.to_string()).collect::<Vec<_>>().join("\n");
         let b = bounded(&many);
         assert_eq!(b.lines().count(), MAX_LINES + 1);

@@ -30,6 +30,7 @@ mod mannequin_file;
 mod mannequin_population;
 mod mannequin_quality;
 mod measure_plausibility;
+mod measure_posed;
 mod measurements;
 mod outputs;
 mod pose_symmetry;

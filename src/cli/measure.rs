@@ -128,19 +128,19 @@ fn print_text(m: &MeasureReport, at: &[f64]) {
     b("shoulder slope", &d.shoulder_slope_deg, "deg");
     g("across back", d.across_back_mm);
     g("across front", d.across_front_mm);
-    for (name, girth) in [
-        ("chest", m.measurements.chest),
-        ("waist", m.measurements.waist),
-        ("hip", m.measurements.hip),
-    ] {
-        outln!(
-            "  {:<22} {:7.1} mm at z = {:.0} mm (contour {:.1} mm)",
-            format!("{name} girth"),
-            girth.tape,
-            girth.z,
-            girth.contour
-        );
-    }
+    let at_level = |name: &str, tape: f64, z: f64, contour: Option<f64>| {
+        let contour = contour.map(|c| format!(" (contour {c:.1} mm)")).unwrap_or_default();
+        if tape.is_nan() || z.is_nan() {
+            outln!("  {name:<22} not measured")
+        } else {
+            outln!("  {name:<22} {tape:7.1} mm at z = {z:.0} mm{contour}")
+        }
+    };
+    let (bust, waist, hip) = (m.measurements.chest, m.measurements.waist, m.measurements.hip);
+    at_level("chest girth", d.chest_girth_mm, d.chest_height_mm, None);
+    at_level("bust girth", d.bust_girth_mm, bust.z, Some(bust.contour));
+    at_level("waist girth", d.waist_girth_mm, waist.z, Some(waist.contour));
+    at_level("hip girth", d.hip_girth_mm, hip.z, Some(hip.contour));
     g("underbust girth", d.underbust_girth_mm);
     g("high hip girth", d.high_hip_girth_mm);
     b("thigh girth", &d.thigh_girth_mm, "mm");

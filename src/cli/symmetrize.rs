@@ -9,7 +9,8 @@ use super::{
 use dressform::body::scan::{self, ScanOptions};
 use dressform::run::outputs::Outputs;
 use dressform::run::pipeline::{STEPS, symmetrize};
-use dressform::shape::measure::Comparison;
+use dressform::shape::mannequin::MannequinError;
+use dressform::shape::measure::{Comparison, stance};
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
@@ -36,6 +37,10 @@ pub struct SymmetrizeArgs {
     report: ReportArgs,
 }
 
+/// What a failed `symmetrize` adds for a scan whose stance it could not take apart.
+const RECONSTRUCT_HINT: &str = "; symmetrize takes a scan in the A-pose (arms out, feet apart, \
+     trunk upright): `dressform reconstruct` re-poses a scan in any other stance first";
+
 pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     let bar = progress_bar(args.json, STEPS.len() as u64 + 2);
     bar.set_message("reading the scan");
@@ -50,7 +55,13 @@ pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
         bar.inc(1);
         bar.set_message(STEPS[step]);
     })
-    .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
+    .map_err(|e| {
+        // A stance the segmentation cannot take apart: `reconstruct` re-poses it first.
+        let posed = !matches!(e, MannequinError::TooFewLayers { .. });
+        let hint = if posed { RECONSTRUCT_HINT } else { "" };
+        Failure::bad_input(format!("{file}: {e}{hint}"))
+    })?;
+    print_warnings(&file, &stance::warnings(&result.regions.landmarks), Some(&bar));
     bar.inc(1);
     bar.set_message("writing");
 

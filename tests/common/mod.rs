@@ -67,13 +67,19 @@ pub fn dressform(args: &[&str]) -> (i32, String, String) {
     )
 }
 
-/// The files of an output directory (following links), by name, without hidden entries.
+/// The files of an output directory, by name, without hidden entries; each must be a plain
+/// file (not a link).
 pub fn output_files(dir: &std::path::Path) -> Vec<(String, Vec<u8>)> {
     let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
         .unwrap()
         .flatten()
         .map(|e| e.file_name().into_string().unwrap())
         .filter(|n| !n.starts_with('.'))
+        .inspect(|n| {
+            // Outputs are plain files a person can e-mail (issue 33), not links.
+            let kind = std::fs::symlink_metadata(dir.join(n)).unwrap().file_type();
+            assert!(kind.is_file(), "{n} in {} is not a plain file", dir.display());
+        })
         .map(|n| (n.clone(), std::fs::read(dir.join(&n)).unwrap()))
         .collect();
     files.sort();

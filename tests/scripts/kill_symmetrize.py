@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
 """kill -9 at random moments of `dressform symmetrize` writing into a directory that holds an
 older output set; after every kill the directory must hold the old set or the new set, whole
-(issue 16). After the last kill one complete run must leave no stray temporaries.
+(issue 16), as plain files (issue 33). After the last kill one complete run must leave no stray
+temporaries.
 
 Two option sets (A: the defaults, B: 60 torso layers) make two different output sets; each
 round runs the one the directory does not hold, so there is always an older set to replace.
 Kill times are spread over the whole run and, more densely, around the moment the outputs are
-committed (the end of the run), measured from clean runs first.
+committed (the end of the run), measured from clean runs first; a quarter of the kills watch
+for the new folder built beside the directory and land inside the commit.
 
 Usage: python3 tests/scripts/kill_symmetrize.py [--rounds 100] [--binary PATH] [--scan PATH]
 Slow (a full symmetrize run per round): not part of CI. Exit status 0 when every check held.
@@ -44,15 +46,16 @@ def run(binary, scan, out, which):
     return subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
 
 
+def beside(out):
+    """Folders a commit builds beside the output directory (left there only by a kill)."""
+    return sorted(p.name for p in out.parent.iterdir() if p.name.startswith(f".{out.name}.dressform-"))
+
+
 def stray(out):
-    """Temporaries a finished run must not leave: unused sets, half-placed links, temp files."""
-    store = out / ".dressform"
-    sets = sorted(p.name for p in (store / "sets").iterdir())
-    current = os.readlink(store / "current").split("/")[-1]
-    left = [f"sets/{s}" for s in sets if s != current]
-    left += [p.name for p in out.iterdir() if p.name.endswith(".dressform-new")]
-    left += [p.name for p in store.iterdir() if p.name.endswith(".dressform-new")]
-    left += [p.name for p in out.iterdir() if p.name.startswith(".dressform-")]
+    """Temporaries a finished run must not leave: folders beside, temporary files, links."""
+    left = beside(out)
+    left += [p.name for p in out.iterdir() if p.name.startswith(".dressform-") and p.name != ".dressform-outputs"]
+    left += [p.name for p in out.iterdir() if p.is_symlink() or not p.is_file()]
     return left
 
 
@@ -92,16 +95,26 @@ def main():
         p = run(binary, scan, out, "A")
         p.communicate()
         holds = "A"
-        counts = {"old": 0, "new": 0, "left a partial set": 0}
+        counts = {"old": 0, "new": 0, "left a folder beside": 0}
         for round_ in range(args.rounds):
             target = "B" if holds == "A" else "A"
-            # Half the kills anywhere in the run, half in the last 15% (the commit).
+            # Half the kills anywhere in the run, a quarter in the last 15%, a quarter inside
+            # the commit itself.
             if round_ % 2 == 0:
                 delay = random.uniform(0.0, 1.1 * duration)
             else:
                 delay = random.uniform(0.85 * duration, 1.05 * duration)
             p = run(binary, scan, out, target)
-            time.sleep(delay)
+            if round_ % 4 == 3:
+                # Inside the commit: as soon as the new folder appears beside the directory,
+                # or a moment later (the swap comes about 13 ms after it).
+                later = random.uniform(0.0, 0.02)
+                while not beside(out) and p.poll() is None:
+                    time.sleep(0.0002)
+                delay = "the commit + %.3f" % later
+                time.sleep(later)
+            else:
+                time.sleep(delay)
             p.send_signal(signal.SIGKILL)
             p.wait()
             now = digest(out)
@@ -113,9 +126,9 @@ def main():
             else:
                 mixed = {n: ("A" if h == sets["A"][n] else "B" if h == sets["B"][n] else h)
                          for n, h in now.items()}
-                sys.exit(f"round {round_}: killed after {delay:.3f} s, the directory holds a mix: {mixed}")
-            if len(list((out / ".dressform" / "sets").iterdir())) > 1:
-                counts["left a partial set"] += 1
+                sys.exit(f"round {round_}: killed after {delay} s, the directory holds a mix: {mixed}")
+            if beside(out):
+                counts["left a folder beside"] += 1
         print("after each kill the directory held:", counts)
 
         p = run(binary, scan, out, "B" if holds == "A" else "A")

@@ -17,7 +17,7 @@ pub struct Definition {
 }
 
 /// Every body dimension, in [`crate::shape::measure::BodyDimensions`]'s order.
-pub const DEFINITIONS: [Definition; 25] = [
+pub const DEFINITIONS: [Definition; 27] = [
     Definition {
         key: "stature_mm",
         name: "Stature",
@@ -65,9 +65,20 @@ pub const DEFINITIONS: [Definition; 25] = [
     },
     Definition {
         key: "chest_girth_mm",
-        name: "Chest (bust) girth",
-        definition: "Horizontal girth under the armpits, across the most prominent points of \
-                     the chest (the bust points).",
+        name: "Chest girth",
+        definition: "Maximum horizontal girth under the armpits, over the shoulder blades and \
+                     across the chest.",
+    },
+    Definition {
+        key: "chest_height_mm",
+        name: "Chest height",
+        definition: "Vertical distance from the floor to the chest girth's level.",
+    },
+    Definition {
+        key: "bust_girth_mm",
+        name: "Bust girth",
+        definition: "Horizontal girth across the bust points (here the nipple line's \
+                     proportion on a flat chest).",
     },
     Definition {
         key: "underbust_girth_mm",

@@ -429,7 +429,7 @@ mod tests {
         assert!(wrist.contains("not measured"), "{wrist}");
         assert!(wrist.contains(&format!("Not measured (right): {reason}")), "{wrist}");
         assert!(!html.contains("57.7"), "a held-back number is never shown");
-        assert!(html.contains("<tr id=\"chest_girth_mm\"><th scope=\"row\">Chest (bust) girth"));
+        assert!(html.contains("<tr id=\"chest_girth_mm\"><th scope=\"row\">Chest girth"));
         assert!(html.contains("Shoulder slope (°)") && html.contains("+0.5"));
         assert!(html.contains("a hole in the scan crosses the waist level"));
         assert!(!html.contains("<script") && !html.contains("src=\"http"));

@@ -55,10 +55,15 @@ pub struct BodyDimensions {
     /// Shoulder slope: the angle below horizontal of the line from the side of the neck (the
     /// neck section's outermost point at the neck level) to the shoulder point.
     pub shoulder_slope_deg: Bilateral,
-    /// Chest (bust) girth: the horizontal tape girth across the bust points, below the lower
-    /// armpit (the chest level of [`Levels`]: the most forward level above the fold under the
-    /// bust, or the nipple line of the standard proportions on a flat chest).
+    /// Chest girth: the fullest horizontal tape girth under the armpits and across the bust
+    /// points ([`super::chest_girth`]).
     pub chest_girth_mm: f64,
+    /// Chest height: floor to the chest girth's level.
+    pub chest_height_mm: f64,
+    /// Bust girth: the horizontal tape girth across the bust points, below the lower armpit
+    /// (the chest level of [`Levels`]: the most forward level above the fold under the bust,
+    /// or the nipple line of the standard proportions on a flat chest).
+    pub bust_girth_mm: f64,
     /// Underbust girth: the horizontal tape girth where the front is set farthest back
     /// between the chest level and 10% of the stature below it (the fold under the breasts).
     pub underbust_girth_mm: f64,
@@ -145,13 +150,24 @@ fn leg_girths(body: &SegmentedBody, zs: &[f64]) -> Vec<(f64, f64)> {
 /// torso's levels between the chest level and [`UNDERBUST_SPAN`] of the stature below it.
 /// `None` if the torso has no loops there.
 pub fn underbust(body: &SegmentedBody, levels: &Levels) -> Option<Girth> {
-    let under = heights(underbust_band(levels, body.landmarks().height).0, levels.chest);
-    let profile: Vec<(f64, Contour)> = (under.iter().copied())
-        .zip(body.torso_sections(&under))
-        .filter_map(|(z, c)| Some((z, c?)))
-        .collect();
+    let profile = underbust_profile(body, levels);
     let k = underbust_in(&profile)?;
     Some(Girth::of(profile[k].0, &profile[k].1))
+}
+
+/// The level of the fold under the bust ([`underbust_fold`]), if the body has one.
+pub fn underbust_fold_level(body: &SegmentedBody, levels: &Levels) -> Option<f64> {
+    let profile = underbust_profile(body, levels);
+    underbust_fold(&profile).map(|k| profile[k].0)
+}
+
+/// The torso's sections in [`underbust_band`], by ascending height.
+fn underbust_profile(body: &SegmentedBody, levels: &Levels) -> Vec<(f64, Contour)> {
+    let under = heights(underbust_band(levels, body.landmarks().height).0, levels.chest);
+    (under.iter().copied())
+        .zip(body.torso_sections(&under))
+        .filter_map(|(z, c)| Some((z, c?)))
+        .collect()
 }
 
 /// The heights (low, high) between which the underbust is looked for on a body of stature
@@ -186,6 +202,7 @@ pub fn dimensions(body: &SegmentedBody, levels: &Levels) -> BodyDimensions {
     let torso = |zs: &[f64]| body.torso_sections(zs);
 
     let underbust = underbust(body, levels).map_or(0.0, |g| g.tape);
+    let chest = super::chest_girth(body, levels);
 
     let main =
         torso(&[levels.chest, levels.waist, 0.5 * (levels.waist + levels.hip), levels.hip, m.neck]);
@@ -226,7 +243,9 @@ pub fn dimensions(body: &SegmentedBody, levels: &Levels) -> BodyDimensions {
         across_back_mm: upper_value(|u| u.across_back),
         across_front_mm: upper_value(|u| u.across_front),
         shoulder_slope_deg: Bilateral::new(slope(ls, neck_side(1.0)), slope(rs, neck_side(-1.0))),
-        chest_girth_mm: tape(&main[0]),
+        chest_girth_mm: chest.map_or(0.0, |g| g.tape),
+        chest_height_mm: chest.map_or(f64::NAN, |g| g.z),
+        bust_girth_mm: tape(&main[0]),
         underbust_girth_mm: underbust,
         waist_girth_mm: tape(&main[1]),
         waist_height_mm: levels.waist,

@@ -2,15 +2,17 @@
 //!
 //! Every girth is horizontal and taken on the torso's loop; the tape girth is the convex
 //! hull's perimeter. Levels are found on the input body (canonical frame, mm):
-//! - **chest** (bust): at the bust point's level, below the lower armpit (ISO 8559-1 takes the
-//!   chest and bust girths horizontally across the bust points; above the lower armpit a raised
-//!   arm would join the loop). The bust point is the torso's most forward level above the fold
-//!   under the bust, looked for from 10% of the height below the lower armpit up to
-//!   [`CHEST_BELOW_ARMPIT_MM`] below it; a chest with no fold at least [`BUST_FOLD_MM`] deep (a
-//!   flat or male chest, whose nipples a scan does not show) takes the nipple line of the
-//!   standard body proportions, [`BUST_POINT_OF_STATURE`] of the stature. Not the largest
-//!   girth under the armpit: on many bodies that is at the armpit itself, where a raised arm
-//!   swells the torso and the level moves with the armpit;
+//! - **chest** (the bust level; Table 1's chest): at the bust points' level, below the lower
+//!   armpit (ISO 8559-1 takes the bust girth horizontally across the bust points; above the
+//!   lower armpit a raised arm would join the loop). The bust point is the torso's most forward
+//!   level above the fold under the bust, looked for from 10% of the height below the lower
+//!   armpit up to [`CHEST_BELOW_ARMPIT_MM`] below it; a chest with no fold at least
+//!   [`BUST_FOLD_MM`] deep (a flat or male chest, whose nipples a scan does not show) takes the
+//!   nipple line of the standard body proportions, [`BUST_POINT_OF_STATURE`] of the stature.
+//!   This is the level the mannequin keeps exactly and the form's chest ring shapes. ISO 8559-1's
+//!   **chest girth** is another measurement ([`chest_girth`]): the fullest girth under the
+//!   armpits, from the same band up to [`CHEST_TAPE_BELOW_ARMPIT_MM`] under the lower armpit
+//!   (and across the bust points where they lie higher);
 //! - **hip**: where the buttocks protrude most (the torso's greatest +Y, i.e. backward, extent)
 //!   between the crotch and 35% of the way up to the armpits; where they protrude within 1 mm of
 //!   that over a range of levels (a flat seat), the middle of that range;
@@ -33,18 +35,22 @@ mod neck_and_shoulders;
 mod plane;
 mod plausibility;
 mod scan_report;
+pub mod stance;
 
 pub use arms::{ArmMeasures, ArmSection, UPPER_ARM_OF_STATURE, WRIST_FROM_FINGERTIP, arms};
 pub use compare::{Comparison, MirrorRow, TableRow, compare};
 pub use dimensions::{
     Bilateral, BodyDimensions, KNEE_OF_CROTCH, THIGH_BELOW_CROTCH, dimensions, underbust,
-    underbust_band, underbust_fold, underbust_in,
+    underbust_band, underbust_fold, underbust_fold_level, underbust_in,
 };
 pub use neck_and_shoulders::{
     MIDLINE_BAND_MM, NeckAndShoulders, PlaneMeasure, across_back_and_front, neck_and_shoulders,
 };
 pub use plane::{PlaneLoop, tape_arc};
-pub use plausibility::{LIMITS, MAX_SIDE_DIFFERENCE, Unreliable, WRIST_GIRTH_MM, hold_back, limit};
+pub use plausibility::{
+    LIMITS, MAX_SIDE_DIFFERENCE, Unreliable, WAIST_OVER_NARROWEST_MM, WRIST_GIRTH_MM, hold_back,
+    hold_back_waist, limit,
+};
 pub use scan_report::{MeasureReport, measure_scan};
 
 use crate::body::mesh::Mesh;
@@ -63,6 +69,12 @@ const LEVEL_STEP_MM: f64 = 2.0;
 const CHEST_BELOW_ARMPIT_MM: f64 = LEVEL_STEP_MM;
 /// How far below the lower armpit the bust point is looked for, as a fraction of the stature.
 const BUST_SPAN: f64 = 0.10;
+/// How far below the lower armpit the chest girth's tape lies at the least (mm): half the
+/// width of a tailor's tape (16 mm: 8 mm) with its upper edge in the armpit, plus how far a
+/// found armpit may lie from the body's (up to 15 mm, `tests/segmentation_stances.rs`). Higher,
+/// in the armpit itself, the torso's girth grows by 3-4 mm per mm of height (MakeHuman's
+/// bodies) and the level would move with the armpit.
+pub const CHEST_TAPE_BELOW_ARMPIT_MM: f64 = 25.0;
 /// The least depth of the fold under a bust (mm) for the bust point to be found on the body:
 /// well above a scanner's noise after smoothing and the 1-5 mm fold of MakeHuman's flat and
 /// male chests, whose most forward level wanders by a centimetre with a slight pose.
@@ -207,6 +219,38 @@ pub fn find_levels(body: &SegmentedBody) -> FoundLevels {
     FoundLevels { levels: Levels { chest, waist, hip }, fallbacks }
 }
 
+/// ISO 8559-1's chest girth and its level: the fullest horizontal tape girth under the
+/// armpits, among the torso's levels from [`BUST_SPAN`] of the stature below the lower armpit up
+/// to [`CHEST_TAPE_BELOW_ARMPIT_MM`] below it, and the bust level of `levels` (the tape passes
+/// across the bust points, even where they lie that close under the armpit). `None` where the
+/// torso has no loop there.
+pub fn chest_girth(body: &SegmentedBody, levels: &Levels) -> Option<Girth> {
+    let m = body.landmarks();
+    let armpit = m.left_armpit.min(m.right_armpit);
+    let top = (armpit - CHEST_TAPE_BELOW_ARMPIT_MM).max(levels.chest);
+    let mut zs = heights_between(armpit - BUST_SPAN * m.height, top);
+    zs.push(levels.chest);
+    let loops = body.torso_sections(&zs);
+    zs.iter()
+        .zip(&loops)
+        .filter_map(|(&z, l)| l.as_ref().map(|c| Girth::of(z, c)))
+        .max_by(|a, b| a.tape.total_cmp(&b.tape))
+}
+
+/// The torso's narrowest tape girth between the hip level and the fold under the bust (the
+/// chest level on a body without one), where it lies strictly inside that span: where the
+/// waist's rule should have found the waist. `None` where the torso narrows to either end (a
+/// barrel torso, whose waist is taken from a proportion).
+pub fn narrowest_above_the_hip(body: &SegmentedBody, levels: &Levels) -> Option<Girth> {
+    let top = underbust_fold_level(body, levels).unwrap_or(levels.chest);
+    let zs = heights_between(levels.hip, top);
+    let loops = body.torso_sections(&zs);
+    let girths: Vec<Girth> =
+        zs.iter().zip(&loops).filter_map(|(&z, l)| l.as_ref().map(|c| Girth::of(z, c))).collect();
+    let k = (0..girths.len()).min_by(|&a, &b| girths[a].tape.total_cmp(&girths[b].tape))?;
+    (k > 0 && k + 1 < girths.len()).then_some(girths[k])
+}
+
 /// The chest level among `samples` (torso loops by ascending height) below the lower `armpit`
 /// of a body `height` tall: see the module documentation.
 fn chest_level(samples: &[(f64, &Contour)], armpit: f64, height: f64) -> (f64, Option<String>) {
@@ -264,7 +308,7 @@ fn deepest_fold(forward: &[f64], min_depth: f64) -> Option<(usize, f64)> {
 /// Where the girths of `body` at `levels` are unreliable: a hole in the scan crossing a
 /// level (its loop is closed with a straight edge across the hole).
 pub fn warnings(body: &Mesh, levels: &Levels) -> Vec<String> {
-    let names = ["chest", "waist", "hip"];
+    let names = ["bust", "waist", "hip"];
     sections(body, &[levels.chest, levels.waist, levels.hip])
         .iter()
         .zip(names)
@@ -290,7 +334,7 @@ pub fn contact_warnings(landmarks: &Landmarks, levels: &Levels) -> Vec<String> {
         .filter_map(|(side, a): (_, &Armhole)| a.contact.map(|c| (side, c.from, a.armpit.z)));
     let mut out = Vec::new();
     for (side, from, armpit) in resting {
-        for (name, z) in [("chest", levels.chest), ("waist", levels.waist), ("hip", levels.hip)] {
+        for (name, z) in [("bust", levels.chest), ("waist", levels.waist), ("hip", levels.hip)] {
             if (from..armpit).contains(&z) {
                 out.push(format!(
                     "the {side} arm rests on the torso from {from:.0} to {armpit:.0} mm: the \
@@ -370,6 +414,6 @@ mod tests {
         let warned = contact_warnings(&landmarks, &at(1280.0));
         assert_eq!(warned.len(), 1, "{warned:?}");
         assert!(warned[0].contains("right arm rests on the torso from 1270 to 1300 mm"));
-        assert!(warned[0].contains("chest girth at z = 1280 mm"), "{}", warned[0]);
+        assert!(warned[0].contains("bust girth at z = 1280 mm"), "{}", warned[0]);
     }
 }

@@ -4,7 +4,7 @@
 
 use super::{
     BodyDimensions, Girth, Levels, Measurements, Unreliable, contact_warnings, dimensions,
-    find_levels, hold_back, measure_at, warnings,
+    find_levels, hold_back, hold_back_waist, measure_at, narrowest_above_the_hip, stance, warnings,
 };
 use crate::body::regions::{Landmarks, RegionError};
 use crate::body::scan::Scan;
@@ -48,12 +48,24 @@ pub fn measure_scan(scan: &Scan, at: &[f64]) -> Result<MeasureReport, RegionErro
             (body, found.levels, found.fallbacks)
         }
     };
-    let measurements = measure_at(&body, &levels);
+    let mut measurements = measure_at(&body, &levels);
     let mut dimensions = dimensions(&body, &levels);
-    let unreliable = hold_back(&mut dimensions);
+    let mut unreliable = hold_back(&mut dimensions);
+    // A mannequin's levels are the customer's, carried: not looked for on its own shape.
+    if scan.carried.is_none() {
+        let narrowest = narrowest_above_the_hip(&body, &levels);
+        unreliable.extend(hold_back_waist(&mut dimensions, levels.waist, narrowest));
+    }
+    if dimensions.waist_girth_mm.is_nan() {
+        measurements.waist.tape = f64::NAN;
+        measurements.waist.contour = f64::NAN;
+    }
     let mut warnings = warnings(&scan.body, &levels);
     warnings.extend(unreliable.iter().map(Unreliable::to_string));
     warnings.extend(contact_warnings(body.landmarks(), &levels));
+    if scan.carried.is_none() {
+        warnings.extend(stance::warnings(body.landmarks()));
+    }
     warnings.extend(fallbacks);
     let at = body
         .torso_sections(at)
