@@ -16,6 +16,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use dressform::atomic_output::OutputSet;
+use dressform::body::mesh::decimate::WORKING_TRIANGLES;
 use dressform::body::scan::{self, ScanOptions};
 use dressform::form::controller::{DEFAULT_FORCE_WINDOW, DriveOptions, DriveReport};
 use dressform::form::fit_test::sweep::{self, DEFAULT_SWEEP, SweepRange, SweepStep};
@@ -159,8 +160,11 @@ pub fn run(args: &FitTestArgs) -> Result<(), Failure> {
         }
         (None, Some(scan_path)) => {
             let drive = Drive { link: &link, sim: &args.sim, options: &options, tolerance };
-            let scan_options =
-                ScanOptions { frame: args.frame.options(), smooth: args.smooth.smooth };
+            let scan_options = ScanOptions {
+                frame: args.frame.options(),
+                smooth: args.smooth.smooth,
+                max_triangles: Some(WORKING_TRIANGLES),
+            };
             let (scan_path, model_path) = (scan_path.clone(), args.model.clone());
             let prepare = move || {
                 let model = super::model::load(model_path.as_deref())?;

@@ -56,7 +56,11 @@ fn scan_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, Failure> {
 /// Reads, prepares (see [`scan::prepare`]) and measures one scan; its scan's warnings are
 /// printed as it is read.
 fn measure_one(path: &Path, args: &MeasureArgs) -> Result<MeasureReport, Failure> {
-    let options = ScanOptions { frame: args.frame.options(), smooth: args.smooth.smooth };
+    let options = ScanOptions {
+        frame: args.frame.options(),
+        smooth: args.smooth.smooth,
+        max_triangles: None,
+    };
     let prepared = scan::prepare(path, &options).map_err(Failure::bad_input)?;
     let file = prepared.scan.source.display().to_string();
     print_warnings(&file, &prepared.warnings, None);

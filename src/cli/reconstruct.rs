@@ -7,6 +7,7 @@ use super::{
     ExportArgs, Failure, MannequinArgs, ReportArgs, ScanFrameArgs, SmoothArgs, print_warnings,
     progress_bar,
 };
+use dressform::body::mesh::decimate::WORKING_TRIANGLES;
 use dressform::body::scan::{self, ScanOptions};
 use dressform::pose::body_model::BodyModel;
 use dressform::pose::pose_symmetry::PoseOverrides;
@@ -53,7 +54,11 @@ pub fn run(args: &ReconstructArgs) -> Result<(), Failure> {
     bar.set_message("reading the scan");
     let model = super::model::load(args.model.as_deref())?;
     let pose = pose_overrides(args.pose.as_deref(), &model)?;
-    let options = ScanOptions { frame: args.frame.options(), smooth: args.smooth.smooth };
+    let options = ScanOptions {
+        frame: args.frame.options(),
+        smooth: args.smooth.smooth,
+        max_triangles: Some(WORKING_TRIANGLES),
+    };
     let scan::PreparedScan { scan, warnings, .. } =
         scan::prepare(&args.scan, &options).map_err(Failure::bad_input)?;
     let export = args.export.export(&scan)?;

@@ -12,6 +12,7 @@ use super::link::{FormArg, LinkArgs};
 use super::setpoints::fidelity_table;
 use super::{Failure, FrameArgs, LegArgs, ReportArgs, SmoothArgs, print_warnings, progress_bar};
 use dressform::atomic_output::OutputSet;
+use dressform::body::mesh::decimate::WORKING_TRIANGLES;
 use dressform::body::scan::{self, Scan, ScanOptions, format::Export, format::Format};
 use dressform::form::controller::{DriveOptions, DriveReport, LinkSpec};
 use dressform::form::form_fit::{ShapeOutcome, Targets, Tolerance, compare};
@@ -65,7 +66,11 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
     let drive = Drive { link: &link, sim: &args.sim, options: &args.shape.options(), tolerance };
     // Read and checked once the form is claimed (see `shape_form`): nothing here moves it.
     let scan_path = args.scan.clone();
-    let scan_options = ScanOptions { frame: args.frame.options(), smooth: args.smooth.smooth };
+    let scan_options = ScanOptions {
+        frame: args.frame.options(),
+        smooth: args.smooth.smooth,
+        max_triangles: Some(WORKING_TRIANGLES),
+    };
     let (model_path, pose_path) = (args.model.clone(), args.pose.clone());
     let legs = args.legs.options();
     let report = ReportTo { customer: None, also: args.report.clone() };

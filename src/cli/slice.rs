@@ -52,7 +52,8 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
     if let Some(h) = args.heights.iter().find(|h| !h.is_finite()) {
         return Err(Failure::bad_input(format!("--heights: {h} is not a height")));
     }
-    let options = ScanOptions { frame: args.frame.options(), smooth: args.smooth };
+    let options =
+        ScanOptions { frame: args.frame.options(), smooth: args.smooth, max_triangles: None };
     let scan::PreparedScan { scan, warnings, .. } =
         scan::prepare(&args.mesh, &options).map_err(Failure::bad_input)?;
     let file = scan.source.display().to_string();

@@ -6,6 +6,7 @@ use super::{
     ExportArgs, Failure, MannequinArgs, ReportArgs, ScanFrameArgs, SmoothArgs, print_warnings,
     progress_bar,
 };
+use dressform::body::mesh::decimate::WORKING_TRIANGLES;
 use dressform::body::scan::{self, ScanOptions};
 use dressform::run::outputs::Outputs;
 use dressform::run::pipeline::{STEPS, symmetrize};
@@ -44,7 +45,11 @@ const RECONSTRUCT_HINT: &str = "; symmetrize takes a scan in the A-pose (arms ou
 pub fn run(args: &SymmetrizeArgs) -> Result<(), Failure> {
     let bar = progress_bar(args.json, STEPS.len() as u64 + 2);
     bar.set_message("reading the scan");
-    let options = ScanOptions { frame: args.frame.options(), smooth: args.smooth.smooth };
+    let options = ScanOptions {
+        frame: args.frame.options(),
+        smooth: args.smooth.smooth,
+        max_triangles: Some(WORKING_TRIANGLES),
+    };
     let scan::PreparedScan { scan, warnings, .. } =
         scan::prepare(&args.scan, &options).map_err(Failure::bad_input)?;
     let export = args.export.export(&scan)?;

@@ -5,6 +5,7 @@
 
 mod adjacency;
 mod components;
+pub mod decimate;
 mod grow;
 pub mod reduce;
 pub mod smooth;

@@ -4,6 +4,7 @@
 
 use super::frame::FrameOptions;
 use super::{Scan, ScanError, load};
+use crate::body::mesh::decimate::decimate;
 use crate::body::mesh::topology;
 use std::path::Path;
 
@@ -15,6 +16,11 @@ pub struct ScanOptions {
     /// Taubin smoothing passes ([`crate::body::mesh::Mesh::taubin_smooth`]), 0 for none; never
     /// applied to a mannequin dressform made ([`Scan::carried`]).
     pub smooth: usize,
+    /// The most triangles to work on: a denser scan is decimated to this many after reading
+    /// ([`decimate`]; the commands that build a mannequin ask for
+    /// [`crate::body::mesh::decimate::WORKING_TRIANGLES`]); `None` keeps every triangle (`info`,
+    /// `slice`, `measure` report the scan as it is).
+    pub max_triangles: Option<usize>,
 }
 
 /// A scan read and prepared for a command.
@@ -32,16 +38,31 @@ pub struct PreparedScan {
 /// Reads the scan at `path` in the frame `options` give, gathers its warnings and smooths
 /// it (see [`PreparedScan::new`]).
 pub fn prepare(path: &Path, options: &ScanOptions) -> Result<PreparedScan, ScanError> {
-    Ok(PreparedScan::new(load(path, &options.frame)?, options.smooth))
+    let scan = load(path, &options.frame)?;
+    Ok(PreparedScan::reduced(scan, options.smooth, options.max_triangles))
 }
 
 impl PreparedScan {
     /// `scan` (already read) with its warnings gathered (the cleaning's, then the topology's),
     /// and smoothed with `passes` Taubin passes unless it is a mannequin dressform made: that
     /// has no scanner noise, and is measured as it is, at the levels its file carries.
-    pub fn new(mut scan: Scan, passes: usize) -> PreparedScan {
+    pub fn new(scan: Scan, passes: usize) -> PreparedScan {
+        PreparedScan::reduced(scan, passes, None)
+    }
+
+    /// [`Self::new`], the scan decimated to at most `max_triangles` between its warnings (which
+    /// describe the scan as read) and the smoothing; a note says so.
+    pub fn reduced(mut scan: Scan, passes: usize, max_triangles: Option<usize>) -> PreparedScan {
         let mut warnings = scan.cleaning.warnings();
         warnings.extend(topology(&scan.body).warnings());
+        if let Some((body, d)) = max_triangles.and_then(|max| decimate(&scan.body, max)) {
+            scan.body = body;
+            warnings.push(format!(
+                "{} triangles, more than the pipeline needs: decimated to {} (largest deviation \
+                 {:.1} mm)",
+                d.from_triangles, d.to_triangles, d.error
+            ));
+        }
         let smoothed = passes > 0 && scan.carried.is_none();
         if smoothed {
             scan.body.taubin_smooth(passes);
