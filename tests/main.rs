@@ -5,6 +5,7 @@ mod common;
 
 mod analytic_sections;
 mod bad_input;
+mod batch;
 mod body_model;
 mod canonical_frame;
 mod controller_claim;

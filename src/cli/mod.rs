@@ -25,6 +25,7 @@ macro_rules! errln {
     };
 }
 
+mod batch;
 #[cfg(feature = "simulator")]
 mod demo;
 mod drive;
@@ -45,6 +46,7 @@ mod sim;
 mod slice;
 mod status;
 mod symmetrize;
+mod watch;
 
 // Without the simulator: `demo` and `sim` still parse, and refuse.
 #[cfg(not(feature = "simulator"))]
@@ -110,6 +112,13 @@ enum Command {
     Reset(reset::ResetArgs),
     /// The robotic form's description: `form show [--toml]`.
     Form(form::FormArgs),
+    /// Process every scan of a folder or manifest into OUT/<customer>/, with a summary.csv;
+    /// sharded across cluster jobs with --shard or Slurm's and Kubernetes' variables.
+    Batch(batch::BatchArgs),
+    /// Join the summaries of a batch's shards into one.
+    BatchMerge(batch::MergeArgs),
+    /// Watch a folder: each scan that lands is processed into OUT/<its name>/.
+    Watch(watch::WatchArgs),
 }
 
 /// How the scan's frame is given on the command line (all optional: detected by default).
@@ -159,6 +168,7 @@ fn units_parser() -> impl TypedValueParser<Value = Units> {
         Units::Dm => "Decimetres (MakeHuman)",
         Units::Cm => "Centimetres",
         Units::Mm => "Millimetres",
+        Units::In => "Inches",
     })
 }
 
@@ -426,6 +436,9 @@ pub fn run(args: Args) -> Result<(), Failure> {
         Command::Model(a) => model::run(&a),
         Command::Reset(a) => reset::run(&a),
         Command::Form(a) => form::run(&a),
+        Command::Batch(a) => batch::run(&a),
+        Command::BatchMerge(a) => batch::merge(&a),
+        Command::Watch(a) => watch::run(&a),
     }
 }
 

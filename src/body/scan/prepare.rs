@@ -23,7 +23,8 @@ pub struct PreparedScan {
     /// The scan, in the canonical frame, smoothed where [`Self::smoothed`] says.
     pub scan: Scan,
     /// What the reader's cleaning found, then what the topology check found (holes,
-    /// manifoldness, orientation): always in that order.
+    /// manifoldness, orientation), then which units were read where another would also make
+    /// a person: always in that order.
     pub warnings: Vec<String>,
     /// Whether the body was smoothed (passes asked for, and not a mannequin dressform made).
     pub smoothed: bool,
@@ -42,6 +43,7 @@ impl PreparedScan {
     pub fn new(mut scan: Scan, passes: usize) -> PreparedScan {
         let mut warnings = scan.cleaning.warnings();
         warnings.extend(topology(&scan.body).warnings());
+        warnings.extend(scan.frame.units_warning());
         let smoothed = passes > 0 && scan.carried.is_none();
         if smoothed {
             scan.body.taubin_smooth(passes);
