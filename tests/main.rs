@@ -46,3 +46,4 @@ mod segmentation_stances;
 mod sim_cli;
 mod synthetic_bodies;
 mod synthetic_mannequin;
+mod watch;

@@ -120,8 +120,8 @@ pub fn run(args: &BatchArgs) -> Result<(), Failure> {
     }
 }
 
-/// One scan's progress line: its customer, status, time and the mannequin's height and
-/// girths, or its error.
+/// One scan's progress line: its customer, status, time, the customer's height and the
+/// mannequin's girths, or its error.
 pub fn progress_line(row: &Row) -> String {
     let mm =
         |k: &str| row.measures.get(k).copied().flatten().map_or("-".into(), |v| format!("{v:.0}"));

@@ -194,15 +194,14 @@ fn pretty(value: &impl Serialize, scan: &Path) -> Result<Vec<u8>, String> {
     serde_json::to_vec_pretty(value).map_err(|e| format!("{}: {e}", messages::path(scan)))
 }
 
-/// The summary's measurements of a reconstruction (see [`super::summary`]): the mannequin's
-/// height, chest, waist and hip (what the form is shaped to), and every ISO 8559-1
-/// dimension of the pose-symmetric scan (as the customer report gives them; held-back
-/// values `None`).
+/// The summary's measurements of a reconstruction (see [`super::summary`]): the customer's
+/// height (the pose-symmetric scan's), the mannequin's chest, waist and hip (what the form
+/// is shaped to), and every ISO 8559-1 dimension of the pose-symmetric scan (as the customer
+/// report gives them; held-back values `None`).
 fn measures(done: &Reshaped) -> BTreeMap<String, Option<f64>> {
     let mut m = BTreeMap::new();
     let symmetrized = &done.shaped.symmetrized;
-    let height = symmetrized.mannequin.mesh.bounds().map(|b| b.max.z - b.min.z);
-    m.insert(super::summary::HEIGHT.to_string(), height);
+    m.insert(super::summary::HEIGHT.to_string(), Some(symmetrized.comparison.input.height));
     for row in &symmetrized.comparison.table {
         m.insert(format!("{}_mm", row.measure), Some(row.mannequin.tape));
     }

@@ -1,7 +1,7 @@
 //! `summary.csv`: one row per scan of a batch (or shard), sorted by customer id: `customer`,
 //! `status` (`done`, `skipped`: its outputs were there from the same input, `failed`),
-//! the mannequin's `height_mm`, `chest_mm`, `waist_mm`, `hip_mm` (what the form is shaped
-//! to), every ISO 8559-1 dimension of the pose-symmetric scan (left and right of the
+//! the customer's `height_mm`, the mannequin's `chest_mm`, `waist_mm`, `hip_mm` (what the
+//! form is shaped to), every ISO 8559-1 dimension of the pose-symmetric scan (left and right of the
 //! bilateral ones in two columns; empty where not measured), `seconds` (wall time) and
 //! `error` (one line, for `failed`). Written atomically; [`merge`] joins shards' summaries.
 
@@ -14,7 +14,7 @@ use std::path::Path;
 
 /// The summary's file name.
 pub const FILE: &str = "summary.csv";
-/// The mannequin's height column.
+/// The customer's height column.
 pub const HEIGHT: &str = "height_mm";
 /// The sides of a bilateral dimension, each a column (`thigh_girth_mm_left`).
 pub const SIDES: [&str; 2] = ["left", "right"];

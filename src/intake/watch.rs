@@ -2,9 +2,11 @@
 //! into `OUT/<scan's stem>/` as it lands.
 //!
 //! - **When a scan counts**: when it was renamed into the folder (a copier that writes
-//!   `name.part` and renames it when done), or when its size and modification time have not
+//!   `.name.part` and renames it when done), or when its size and modification time have not
 //!   changed for the settle time (a copier writing in place; notify does not say when a
-//!   writer is done). Hidden files and files of other formats are not scans.
+//!   writer is done). A file written and renamed within the debouncer's window ([`DEBOUNCE`])
+//!   is reported as created, not renamed, and so counts after the settle time too. Hidden
+//!   files and files of other formats are not scans.
 //! - **Events or polling**: the folder's events (notify, debounced) wake the watcher and mark
 //!   renames; the folder is also listed every [`TICK`] (which is what the settle time is
 //!   measured on). On network shares, where no events are delivered, `poll` lists it every
@@ -26,6 +28,7 @@ use notify_debouncer_full::notify::event::{ModifyKind, RenameMode};
 use notify_debouncer_full::notify::{EventKind, RecursiveMode};
 use notify_debouncer_full::{DebounceEventResult, new_debouncer};
 use std::collections::{HashMap, HashSet};
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
@@ -79,19 +82,28 @@ pub fn watch(
     mut handled: impl FnMut(Handled),
 ) -> Result<(), String> {
     let mut journal = Journal::open(out)?;
-    let (tx, rx) = mpsc::channel::<Vec<PathBuf>>();
+    // The names of the files renamed in, as events report them.
+    let (tx, rx) = mpsc::channel::<Vec<OsString>>();
     // Kept alive while watching; dropped (stopped) on return.
     let _debouncer = match options.poll {
         Some(_) => None,
         None => {
             let on_events = move |result: DebounceEventResult| {
-                let renamed = result.unwrap_or_default().into_iter().filter_map(|e| match e.kind {
+                // Our own listing opens the folder: accesses are no news.
+                let news: Vec<_> = result
+                    .unwrap_or_default()
+                    .into_iter()
+                    .filter(|e| !matches!(e.kind, EventKind::Access(_)))
+                    .collect();
+                let renamed = news.iter().filter_map(|e| match e.kind {
                     EventKind::Modify(ModifyKind::Name(RenameMode::To | RenameMode::Both)) => {
-                        e.paths.last().cloned()
+                        e.paths.last().and_then(|p| p.file_name()).map(OsString::from)
                     }
                     _ => None,
                 });
-                let _ = tx.send(renamed.collect());
+                if !news.is_empty() {
+                    let _ = tx.send(renamed.collect());
+                }
             };
             let mut debouncer = new_debouncer(DEBOUNCE, None, on_events).map_err(|e| {
                 format!("{}: cannot watch: {e} (try --poll)", messages::path(input))
@@ -104,7 +116,7 @@ pub fn watch(
     };
     let tick = options.poll.unwrap_or(TICK);
     let mut seen: HashMap<PathBuf, (Stamp, Instant)> = HashMap::new();
-    let mut renamed: HashSet<PathBuf> = HashSet::new();
+    let mut renamed: HashSet<OsString> = HashSet::new();
     let mut finished: HashMap<PathBuf, Stamp> = HashMap::new();
     while !stop.load(Ordering::Relaxed) {
         if let Ok(paths) = rx.recv_timeout(tick) {
@@ -122,7 +134,8 @@ pub fn watch(
                 *entry = (stamp, now);
             }
             let settled = now.duration_since(entry.1) >= options.settle;
-            if finished.get(&path) != Some(&stamp) && (settled || renamed.contains(&path)) {
+            let renamed_in = path.file_name().is_some_and(|n| renamed.contains(n));
+            if finished.get(&path) != Some(&stamp) && (settled || renamed_in) {
                 ready.push(path);
             }
         }
@@ -131,7 +144,9 @@ pub fn watch(
             if stop.load(Ordering::Relaxed) {
                 break;
             }
-            renamed.remove(&path);
+            if let Some(name) = path.file_name() {
+                renamed.remove(name);
+            }
             if let Some(stamp) = stamp_of(&path) {
                 finished.insert(path.clone(), stamp);
             }
