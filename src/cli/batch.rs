@@ -20,6 +20,9 @@ pub struct IntakeArgs {
     /// The body model (.glb) [default: the built-in model].
     #[arg(long)]
     model: Option<PathBuf>,
+    /// Joint angles to set on every symmetric pose (TOML; see docs/formats.md).
+    #[arg(long)]
+    pose: Option<PathBuf>,
     #[command(flatten)]
     form: FormArg,
     #[command(flatten)]
@@ -33,9 +36,15 @@ pub struct IntakeArgs {
 impl IntakeArgs {
     /// The processor these options describe (the model and form loaded).
     pub fn processor(&self) -> Result<Processor, Failure> {
+        let model = super::model::load(self.model.as_deref())?;
+        let pose = super::reconstruct::pose_overrides(self.pose.as_deref(), &model)?;
         Ok(Processor {
-            model: super::model::load(self.model.as_deref())?,
-            options: ReconstructOptions { mannequin: self.legs.options(), ..Default::default() },
+            model,
+            options: ReconstructOptions {
+                pose,
+                mannequin: self.legs.options(),
+                ..Default::default()
+            },
             form: self.form.load()?,
             smooth: self.smooth.smooth,
         })
@@ -161,30 +170,11 @@ pub struct MergeArgs {
 }
 
 pub fn merge(args: &MergeArgs) -> Result<(), Failure> {
-    let mut files = Vec::new();
-    for path in &args.summaries {
-        if !path.is_dir() {
-            files.push(path.clone());
-            continue;
-        }
-        let read = std::fs::read_dir(path)
-            .map_err(|e| Failure::bad_input(format!("{}: cannot read: {e}", path.display())))?;
-        let mut found: Vec<PathBuf> = read
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| {
-                let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
-                name.starts_with(SHARD_PREFIX) && name.ends_with(".csv")
-            })
-            .collect();
-        if found.is_empty() {
-            return Err(Failure::bad_input(format!(
-                "{}: no {SHARD_PREFIX}*.csv in this folder",
-                path.display()
-            )));
-        }
-        found.sort();
-        files.extend(found);
-    }
+    let shard = |p: &Path| {
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        name.starts_with(SHARD_PREFIX) && name.ends_with(".csv")
+    };
+    let files = super::files_in(&args.summaries, shard, &format!("{SHARD_PREFIX}*.csv"))?;
     let inputs: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
     let rows = summary::merge(&inputs, &args.out).map_err(Failure::bad_input)?;
     outln!("{rows} scans from {} summaries in {}", inputs.len(), args.out.display());

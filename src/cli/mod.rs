@@ -468,6 +468,35 @@ pub fn output_failed() -> bool {
     OUTPUT_FAILED.load(Ordering::Relaxed)
 }
 
+/// The files `paths` name: files as given, and in each folder among them its files that are
+/// `wanted` (sorted by name); a folder with none is an error naming `what` it lacks.
+fn files_in(
+    paths: &[PathBuf],
+    wanted: impl Fn(&Path) -> bool,
+    what: &str,
+) -> Result<Vec<PathBuf>, Failure> {
+    let mut files = Vec::new();
+    for path in paths {
+        if !path.is_dir() {
+            files.push(path.clone());
+            continue;
+        }
+        let read = std::fs::read_dir(path)
+            .map_err(|e| Failure::bad_input(format!("{}: cannot read: {e}", path.display())))?;
+        let mut found: Vec<PathBuf> =
+            read.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| wanted(p)).collect();
+        if found.is_empty() {
+            return Err(Failure::bad_input(format!(
+                "{}: no {what} in this directory",
+                path.display()
+            )));
+        }
+        found.sort();
+        files.extend(found);
+    }
+    Ok(files)
+}
+
 /// Prints a warning about `file` on standard error (bounded: see [`messages::bounded`]).
 fn warn(file: &str, message: &str) {
     errln!("warning: {}", messages::bounded(&format!("{file}: {message}")));
