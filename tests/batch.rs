@@ -21,17 +21,18 @@ fn write_scans(dir: &Path, n: u64) {
 
 /// A summary's rows by customer, each a map from column to value, without `seconds`.
 fn rows(path: &Path) -> BTreeMap<String, BTreeMap<String, String>> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    lines
-        .map(|line| {
-            let cells: Vec<&str> = line.split(',').collect();
-            assert_eq!(cells.len(), header.len(), "{line}");
+    let mut reader =
+        csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let header = reader.headers().unwrap().clone();
+    reader
+        .records()
+        .map(|record| {
+            let record = record.unwrap();
+            assert_eq!(record.len(), header.len(), "{record:?}");
             let row: BTreeMap<String, String> = header
                 .iter()
-                .zip(&cells)
-                .filter(|(h, _)| **h != "seconds")
+                .zip(record.iter())
+                .filter(|(h, _)| *h != "seconds")
                 .map(|(h, c)| (h.to_string(), c.to_string()))
                 .collect();
             (row["customer"].clone(), row)
@@ -148,21 +149,27 @@ fn a_manifest_names_units_and_a_failing_scan_does_not_stop_the_batch() {
     let dir = tmp.path();
     std::fs::write(dir.join("good.ply"), coarse_scan(3)).unwrap();
     std::fs::write(dir.join("broken.ply"), b"ply\nformat ascii 1.0\nelement vertex 3\n").unwrap();
+    // A good scan with a landmark file that has a bad line.
+    std::fs::copy(dir.join("good.ply"), dir.join("marked.ply")).unwrap();
+    std::fs::write(dir.join("marked.txt"), "sellion 0 1.6 0.1\nnavel 0 1.1\n").unwrap();
     let manifest = dir.join("manifest.csv");
-    std::fs::write(&manifest, "path,customer,units,up\ngood.ply,alice,m,y\nbroken.ply,bob,,\n")
-        .unwrap();
+    let listed =
+        "path,customer,units,up\ngood.ply,alice,m,y\nbroken.ply,bob,,\nmarked.ply,carol,,\n";
+    std::fs::write(&manifest, listed).unwrap();
     let out = dir.join("out");
     let (code, stdout, stderr) =
         dressform(&["batch", manifest.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert_eq!(code, 2, "{stdout}{stderr}");
     assert!(
-        stderr.lines().last().unwrap().contains("1 of 2 scans could not be processed"),
+        stderr.lines().last().unwrap().contains("2 of 3 scans could not be processed"),
         "{stderr}"
     );
     let summary = rows(&out.join("summary.csv"));
     assert_eq!(summary["alice"]["status"], "done");
     assert_eq!(summary["bob"]["status"], "failed");
     assert!(summary["bob"]["error"].contains("broken.ply"), "{:?}", summary["bob"]);
+    let carol = &summary["carol"];
+    assert!(carol["error"].contains("marked.txt line 2: expected 'name x y z'"), "{carol:?}");
     assert!(out.join("alice/mannequin.obj").is_file() && !out.join("bob").exists());
 
     // A bad manifest: one line naming the file, the line and the field.

@@ -1,9 +1,10 @@
 //! The watch journal, `OUT/journal.jsonl`: one JSON object a line, appended and flushed to
 //! disk (fsync) before the step it records goes on: `started`, then `done` or `failed`, each
 //! with the scan's file name and input hash. A restart reads it back: a scan whose name and
-//! hash have a `done` (or `failed`) line is not processed again; one that only `started` was
-//! cut short and is processed again (its outputs are all or nothing). A line cut short by a
-//! kill does not parse and is ignored (the next run starts a new line after it).
+//! hash have a `done` line is not processed again; one that only `started` was cut short and
+//! is processed again (its outputs are all or nothing); a `failed` one was moved out of the
+//! folder. A line cut short by a kill does not parse and is ignored (the next run starts a
+//! new line after it).
 
 use crate::messages;
 use serde::{Deserialize, Serialize};

@@ -11,8 +11,8 @@
 //!   renames; the folder is also listed every [`TICK`] (which is what the settle time is
 //!   measured on). On network shares, where no events are delivered, `poll` lists it every
 //!   so often instead.
-//! - **Restarts**: the journal ([`super::journal`]) makes a restart skip every scan done (or
-//!   rejected) with the same content and redo one that was cut short.
+//! - **Restarts**: the journal ([`super::journal`]) makes a restart skip every scan done with
+//!   the same content and redo one that was cut short.
 //! - **Rejected scans** move to `IN/rejected/` with `<name>.error.txt` beside them: what was
 //!   seen, and what to do.
 //! - **Stopping**: `stop` is checked between scans; the scan in hand is finished (its outputs
@@ -174,7 +174,7 @@ fn stamp_of(path: &Path) -> Option<Stamp> {
     Some(Stamp { size: meta.len(), modified: meta.modified().ok() })
 }
 
-/// Processes `job` unless the journal has it done or rejected with the same content:
+/// Processes `job` unless the journal has it done with the same content:
 /// `started`, then the outputs, then `done`; or the scan rejected, then `failed`.
 fn take(
     processor: &Processor,
@@ -188,7 +188,9 @@ fn take(
     let start = Instant::now();
     let (hash, outcome) = match Processor::hash_of(job) {
         Ok(hash) => {
-            if matches!(journal.last(&name, &hash), Some(Event::Done | Event::Failed)) {
+            // A rejected scan was moved away: one with its name and content back in the
+            // folder was put there again, and is tried again.
+            if journal.last(&name, &hash) == Some(Event::Done) {
                 return Ok(());
             }
             journal.record(Event::Started, &name, &hash, "")?;
