@@ -26,6 +26,9 @@
 //!    `sections.svg`), [`run::report`] (`report.html`, the customer report) and [`run::info`]
 //!    (what `dressform info` says about a scan).
 //!
+//! 6. [`intake`]: many scans unattended: `batch` (a folder or manifest, sharded on a cluster)
+//!    and `watch` (a folder as scans land), one per-scan function for both.
+//!
 //! Used by all of them: [`messages`] (how a problem is worded: one bounded line) and [`input`]
 //! (reading the JSON files a user hands in).
 
@@ -33,6 +36,7 @@ pub mod atomic_output;
 pub mod body;
 pub mod form;
 pub mod input;
+pub mod intake;
 pub mod messages;
 pub mod pose;
 pub mod run;

@@ -43,8 +43,9 @@ fn the_same_body_in_other_units_axes_and_formats_has_the_same_height() {
     let body = canonical_body(&dir);
     let tmp = tempfile::tempdir().unwrap();
     type ToFile = fn(DVec3) -> DVec3;
-    let variants: [(&str, ToFile, &str, &str); 4] = [
+    let variants: [(&str, ToFile, &str, &str); 5] = [
         ("metres_z_up.obj", |p| p / 1000.0, "m", "+z"),
+        ("inches_z_up.obj", |p| p / 25.4, "in", "+z"),
         ("mm_y_up.ply", |p| DVec3::new(p.x, p.z, -p.y), "mm", "+y"),
         ("cm_z_up.stl", |p| p / 10.0, "cm", "+z"),
         ("m_minus_y_up.ply", |p| DVec3::new(p.x, -p.z, p.y) / 1000.0, "m", "-y"),
@@ -158,4 +159,85 @@ fn overrides_no_standing_person_has_are_refused_naming_the_fix() {
     // The right overrides pass.
     let (code, _, stderr) = dressform(&["info", file, "--units", "mm", "--up", "z"]);
     assert_eq!(code, 0, "{stderr}");
+}
+
+/// The numbers of two JSON documents, in order, paired (the documents' shapes must match).
+fn numbers_paired(a: &serde_json::Value, b: &serde_json::Value, out: &mut Vec<(f64, f64)>) {
+    use serde_json::Value;
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => {
+            out.push((x.as_f64().unwrap(), y.as_f64().unwrap()))
+        }
+        (Value::Array(x), Value::Array(y)) => {
+            assert_eq!(x.len(), y.len());
+            x.iter().zip(y).for_each(|(x, y)| numbers_paired(x, y, out));
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            assert_eq!(x.keys().collect::<Vec<_>>(), y.keys().collect::<Vec<_>>());
+            x.values().zip(y.values()).for_each(|(x, y)| numbers_paired(x, y, out));
+        }
+        _ => {} // names (the scan's file) differ
+    }
+}
+
+#[test]
+fn a_scan_in_inches_reconstructs_to_the_same_mannequin_as_in_millimetres() {
+    // The demo's scan (metres), written in millimetres and in inches.
+    let tmp = tempfile::tempdir().unwrap();
+    let metres = common::synthetic_scan(tmp.path(), 1);
+    let (body, _) = scan::read_mesh(&metres).unwrap();
+    let mut runs = Vec::new();
+    for (name, scale, units) in [("mm.ply", 1000.0, None), ("in.ply", 1000.0 / 25.4, None)]
+        .into_iter()
+        .chain([("in-given.ply", 1000.0 / 25.4, Some("in"))])
+    {
+        let path = tmp.path().join(name);
+        std::fs::write(&path, Format::Ply.encode(&body.map_positions(|p| p * scale))).unwrap();
+        let out = tmp.path().join(format!("{name}.out"));
+        let mut args = vec!["reconstruct", path.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        if let Some(units) = units {
+            args.extend(["--scan-units", units]);
+        }
+        let (code, _, stderr) = dressform(&args);
+        assert_eq!(code, 0, "{name}: {stderr}");
+        if name == "in.ply" {
+            // Detected, and said so.
+            assert!(stderr.contains("units: read as in"), "{stderr}");
+        }
+        let json = |file: &str| -> serde_json::Value {
+            serde_json::from_slice(&std::fs::read(out.join(file)).unwrap()).unwrap()
+        };
+        runs.push((name, json("measurements.json"), json("profiles.json")));
+    }
+    let (_, mm_measurements, mm_profiles) = &runs[0];
+    for (name, measurements, profiles) in &runs[1..] {
+        let mut pairs = Vec::new();
+        numbers_paired(mm_measurements, measurements, &mut pairs);
+        numbers_paired(mm_profiles, profiles, &mut pairs);
+        let worst = pairs.iter().map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(pairs.len() > 100 && worst < 0.01, "{name}: differs by up to {worst} mm");
+    }
+}
+
+#[test]
+fn a_fit_that_fails_on_a_body_of_unusual_size_names_the_units_assumed() {
+    // A customer's scan scaled to 0.7 m tall, in metres: detected as metres, a body no model
+    // fits; the error says so and how to override the units.
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("small.ply");
+    let (body, _) = scan::read_mesh(&common::synthetic_scan(tmp.path(), 2)).unwrap();
+    std::fs::write(&path, Format::Ply.encode(&body.map_positions(|p| p * (700.0 / 1700.0))))
+        .unwrap();
+    let out = tmp.path().join("out");
+    let (code, _, stderr) =
+        dressform(&["reconstruct", path.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(code, 2, "{stderr}");
+    let last = stderr.lines().last().unwrap();
+    assert!(
+        last.contains("(read as m, detected: 70")
+            && last.contains(" mm tall; if wrong, pass --units): ")
+            && last.contains("did not converge"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
 }

@@ -5,6 +5,7 @@ mod common;
 
 mod analytic_sections;
 mod bad_input;
+mod batch;
 mod body_model;
 mod canonical_frame;
 mod controller_claim;
@@ -46,3 +47,4 @@ mod segmentation_stances;
 mod sim_cli;
 mod synthetic_bodies;
 mod synthetic_mannequin;
+mod watch;

@@ -130,13 +130,38 @@ pub fn run(args: &DriveArgs) -> Result<(), Failure> {
         min_duration,
         ..args.shape.options()
     };
+    let link = Link { spec: args.link.spec(), sim: args.sim.clone(), options, tolerance };
+    drive_to(&form, &link, setpoints, args.json)
+}
+
+/// Where and how [`drive_to`] drives the form.
+pub struct Link {
+    /// Where the form is.
+    pub spec: LinkSpec,
+    /// The simulated form's log and faults.
+    pub sim: SimArgs,
+    /// The drive's options.
+    pub options: DriveOptions,
+    /// How far a ring may be off its girth and level.
+    pub tolerance: Tolerance,
+}
+
+/// Drives `form` over `link` to `setpoints` (checked against its strokes), prints the
+/// report (as JSON with `json`) and judges the shape (exit status 3 when a ring is off): the
+/// end of `drive`, and of each customer's drive in `watch --drive`.
+pub fn drive_to(
+    form: &FormDescription,
+    link: &Link,
+    setpoints: SetPoints,
+    json: bool,
+) -> Result<(), Failure> {
     let (girths_mm, heights_mm) =
         (setpoints.target_girths_mm.clone(), setpoints.target_heights_mm.clone());
     let compute = move || Ok(((), setpoints));
-    let ((), report) = execute(&form, &args.link.spec(), &options, &args.sim, args.json, compute)?;
+    let ((), report) = execute(form, &link.spec, &link.options, &link.sim, json, compute)?;
     let targets = Targets { girths_mm: &girths_mm, heights_mm: &heights_mm };
-    let shape = compare(&form, &report.positions_mm, targets, tolerance);
-    print_report(&report, &shape, args.json)?;
+    let shape = compare(form, &report.positions_mm, targets, link.tolerance);
+    print_report(&report, &shape, json)?;
     shape_verdict(&shape)
 }
 

@@ -29,28 +29,8 @@ pub struct MeasureArgs {
 
 /// The scan files `paths` name: files as given, directories' .obj, .ply and .stl files.
 fn scan_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, Failure> {
-    let mut files = Vec::new();
-    for path in paths {
-        if !path.is_dir() {
-            files.push(path.clone());
-            continue;
-        }
-        let read = std::fs::read_dir(path)
-            .map_err(|e| Failure::bad_input(format!("{}: cannot read: {e}", path.display())))?;
-        let mut found: Vec<PathBuf> = read
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| scan::format::Format::from_path(p).is_some())
-            .collect();
-        if found.is_empty() {
-            return Err(Failure::bad_input(format!(
-                "{}: no .obj, .ply or .stl file in this directory",
-                path.display()
-            )));
-        }
-        found.sort();
-        files.extend(found);
-    }
-    Ok(files)
+    let scan = |p: &Path| scan::format::Format::from_path(p).is_some();
+    super::files_in(paths, scan, ".obj, .ply or .stl file")
 }
 
 /// Reads, prepares (see [`scan::prepare`]) and measures one scan; its scan's warnings are

@@ -25,6 +25,7 @@ macro_rules! errln {
     };
 }
 
+mod batch;
 #[cfg(feature = "simulator")]
 mod demo;
 mod drive;
@@ -45,6 +46,7 @@ mod sim;
 mod slice;
 mod status;
 mod symmetrize;
+mod watch;
 
 // Without the simulator: `demo` and `sim` still parse, and refuse.
 #[cfg(not(feature = "simulator"))]
@@ -110,6 +112,13 @@ enum Command {
     Reset(reset::ResetArgs),
     /// The robotic form's description: `form show [--toml]`.
     Form(form::FormArgs),
+    /// Process every scan of a folder or manifest into OUT/<customer>/, with a summary.csv;
+    /// sharded across cluster jobs with --shard or Slurm's and Kubernetes' variables.
+    Batch(batch::BatchArgs),
+    /// Join the summaries of a batch's shards into one.
+    BatchMerge(batch::MergeArgs),
+    /// Watch a folder: each scan that lands is processed into OUT/<its name>/.
+    Watch(watch::WatchArgs),
 }
 
 /// How the scan's frame is given on the command line (all optional: detected by default).
@@ -159,6 +168,7 @@ fn units_parser() -> impl TypedValueParser<Value = Units> {
         Units::Dm => "Decimetres (MakeHuman)",
         Units::Cm => "Centimetres",
         Units::Mm => "Millimetres",
+        Units::In => "Inches",
     })
 }
 
@@ -426,6 +436,9 @@ pub fn run(args: Args) -> Result<(), Failure> {
         Command::Model(a) => model::run(&a),
         Command::Reset(a) => reset::run(&a),
         Command::Form(a) => form::run(&a),
+        Command::Batch(a) => batch::run(&a),
+        Command::BatchMerge(a) => batch::merge(&a),
+        Command::Watch(a) => watch::run(&a),
     }
 }
 
@@ -453,6 +466,35 @@ pub fn write_err(text: std::fmt::Arguments) {
 /// Whether some output could not be written.
 pub fn output_failed() -> bool {
     OUTPUT_FAILED.load(Ordering::Relaxed)
+}
+
+/// The files `paths` name: files as given, and in each folder among them its files that are
+/// `wanted` (sorted by name); a folder with none is an error naming `what` it lacks.
+fn files_in(
+    paths: &[PathBuf],
+    wanted: impl Fn(&Path) -> bool,
+    what: &str,
+) -> Result<Vec<PathBuf>, Failure> {
+    let mut files = Vec::new();
+    for path in paths {
+        if !path.is_dir() {
+            files.push(path.clone());
+            continue;
+        }
+        let read = std::fs::read_dir(path)
+            .map_err(|e| Failure::bad_input(format!("{}: cannot read: {e}", path.display())))?;
+        let mut found: Vec<PathBuf> =
+            read.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| wanted(p)).collect();
+        if found.is_empty() {
+            return Err(Failure::bad_input(format!(
+                "{}: no {what} in this directory",
+                path.display()
+            )));
+        }
+        found.sort();
+        files.extend(found);
+    }
+    Ok(files)
 }
 
 /// Prints a warning about `file` on standard error (bounded: see [`messages::bounded`]).

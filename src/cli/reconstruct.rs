@@ -70,7 +70,7 @@ pub fn run(args: &ReconstructArgs) -> Result<(), Failure> {
         bar.inc(1);
         bar.set_message(STEPS.iter().chain(&pipeline::STEPS).nth(step).copied().unwrap_or(""));
     })
-    .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
+    .map_err(|e| Failure::bad_input(scan.failed(e)))?;
     bar.inc(1);
     bar.set_message("writing");
 

@@ -240,13 +240,12 @@ fn reconstruct_and_write(
     mut outputs: OutputSet,
     report: &ReportTo,
 ) -> Result<Reshaped, Failure> {
-    let file = scan.source.display().to_string();
     let bar = progress_bar(false, (STEPS.len() + SHAPE_STEPS.len()) as u64);
     let done = reconstruct_shape(scan, &reconstruct.model, &reconstruct.options, form, |step| {
         bar.inc(1);
         bar.set_message(STEPS.iter().chain(&SHAPE_STEPS).nth(step).copied().unwrap_or(""));
     })
-    .map_err(|e| Failure::bad_input(format!("{file}: {e}")))?;
+    .map_err(|e| Failure::bad_input(scan.failed(e)))?;
     let (shaped, export) = (&done.shaped, Export::canonical(Format::Obj));
     let mut files =
         Outputs::reposed(&shaped.symmetrized, &done.reposed, &done.as_scanned, scan, &export)

@@ -4,8 +4,11 @@
 //! terminal or a full disk cannot delay the stop: it calls [`Gate::emergency_stop`] on every
 //! armed link; the session there ends with "stopped by SIGTERM" and the command exits 1.
 //! Should the process not end within [`GRACE`], or a second signal come, it exits at once
-//! (the form is already stopped). With no link armed, a signal does what it does by default.
+//! (the form is already stopped). With no link armed, a signal does what it does by default,
+//! unless the command asked to finish its work first ([`finish_on_signal`]: `watch` ends the
+//! scan in hand, its outputs committed as a whole); a second signal then ends it at once.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, OnceLock, PoisonError};
 use std::time::Duration;
 
@@ -25,6 +28,21 @@ static ARMED: Mutex<Vec<(u64, Gate)>> = Mutex::new(Vec::new());
 
 /// Set once the watching thread runs (or could not be started).
 static WATCHING: OnceLock<()> = OnceLock::new();
+
+/// Whether the command asked to finish its work on a signal ([`finish_on_signal`]).
+static FINISH_ASKED: AtomicBool = AtomicBool::new(false);
+
+/// Set by the first signal when [`FINISH_ASKED`].
+static FINISHING: AtomicBool = AtomicBool::new(false);
+
+/// From now on, the first SIGINT, SIGTERM or SIGHUP with no link armed sets the flag returned
+/// (the command finishes what it is doing, then ends) instead of ending the process; a
+/// signal while a link is armed e-stops it as always, and sets the flag too.
+pub fn finish_on_signal() -> &'static AtomicBool {
+    FINISH_ASKED.store(true, Ordering::SeqCst);
+    WATCHING.get_or_init(watch);
+    &FINISHING
+}
 
 /// A link armed for signals; disarmed when dropped.
 #[must_use = "the link is disarmed when this is dropped"]
@@ -64,6 +82,14 @@ fn watch() {
         let mut stopped = false;
         for signal in signals.forever() {
             let gates: Vec<Gate> = armed().iter().map(|(_, g)| g.clone()).collect();
+            let finishing = FINISHING.swap(true, Ordering::SeqCst);
+            if gates.is_empty() && FINISH_ASKED.load(Ordering::SeqCst) && !finishing {
+                errln!(
+                    "{}: finishing the scan in hand, then stopping (signal again to stop at once)",
+                    name(signal)
+                );
+                continue;
+            }
             if gates.is_empty() {
                 // Nothing to stop: end as the signal would have ended the process.
                 let _ = emulate_default_handler(signal);

@@ -141,7 +141,13 @@ impl ScanInfo {
                 welded_vertices: scan.cleaning.welded_vertices,
                 degenerate_triangles: scan.cleaning.degenerate_triangles,
             },
-            warnings: scan.cleaning.warnings().into_iter().chain(t.warnings()).collect(),
+            warnings: scan
+                .cleaning
+                .warnings()
+                .into_iter()
+                .chain(t.warnings())
+                .chain(frame.units_warning())
+                .collect(),
         }
     }
 }

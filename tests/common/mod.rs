@@ -252,3 +252,19 @@ pub fn with_holes_and_cuts(mut mesh: Mesh, holes: &[DVec3], radius_mm: f64, cuts
     mesh.drop_unused_vertices();
     mesh
 }
+
+/// A coarse scan (8 mm grid, not the default 4: a quarter of the triangles, so that many
+/// scans run quickly) of synthetic customer `k` (1600 + 20 k mm tall), with a typical
+/// scanner's artifacts, as PLY bytes in metres, Y up.
+pub fn coarse_scan(k: u64) -> Vec<u8> {
+    use capture_sim::{Artifacts, BodyParams, capture, generate};
+    let height_mm = 1600.0 + 20.0 * k as f64;
+    // The default body's legs (790 of 1700 mm), in proportion.
+    let leg_length_mm = height_mm * 790.0 / 1700.0;
+    let params = BodyParams { height_mm, leg_length_mm, resolution_mm: 8.0, ..Default::default() };
+    let body = generate(&params).expect("the body generates");
+    let raw = capture(&body, &Artifacts::typical_scanner(k));
+    let mesh =
+        Mesh::new(raw.positions.iter().map(|&p| DVec3::from_array(p)).collect(), raw.triangles);
+    dressform::body::scan::format::Format::Ply.encode(&mesh)
+}

@@ -9,7 +9,13 @@
 //!   sign from the area-weighted centroid, which sits above mid-height (torso, arms and head
 //!   carry more surface than the legs);
 //! - **units**: from the height — a standing person is 0.5-2.5 m tall, and that range in m,
-//!   dm, cm and mm does not overlap;
+//!   dm, cm and mm does not overlap; inches overlap centimetres (a 1.2-2.2 m adult is 47-87
+//!   inches, which in centimetres would be a toddler) and decimetres, so where several units
+//!   make a person, the first (m, dm, cm, mm, in) that makes the body at least 1 m tall
+//!   ([`SMALLEST_CUSTOMER_MM`]) is taken, and the reading is named in a warning
+//!   ([`CanonicalFrame::units_warning`]). Its limit: a scan in centimetres of a child under
+//!   1 m (50-98 units tall) is read as inches, one in inches of a body under 0.64 m as
+//!   decimetres; `--units` overrides;
 //! - **left-right axis**: the major principal axis of the surface between hips and shoulders
 //!   (shoulders, hips and hanging arms are wider than the body is deep); exact for a
 //!   mirror-symmetric body, whatever its turn;
@@ -27,6 +33,19 @@ use std::str::FromStr;
 /// with margin; the ranges in m, dm, cm and mm do not overlap, so the height tells the unit.
 pub const PERSON_HEIGHT_MM: (f64, f64) = (500.0, 2500.0);
 
+/// The smallest stature of a customer a dress form is made for (mm): about a four-year-old
+/// (the WHO Child Growth Standards' median at 4 years is 102-103 cm). Where a scan's height
+/// makes a person in several units, the first unit that makes it at least this tall is taken.
+pub const SMALLEST_CUSTOMER_MM: f64 = 1000.0;
+
+/// The statures of usual customers (mm): from [`SMALLEST_CUSTOMER_MM`] to 2.2 m (above the
+/// 99.99th percentile of adult stature in national surveys). A scan whose detected units
+/// make it another height and that cannot be reconstructed gets a hint naming the units.
+pub const USUAL_STATURE_MM: (f64, f64) = (SMALLEST_CUSTOMER_MM, 2200.0);
+
+/// Millimetres in an inch (international yard and pound agreement, 1959).
+pub const MM_PER_INCH: f64 = 25.4;
+
 /// A length unit a scan may be stored in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -39,19 +58,24 @@ pub enum Units {
     Cm,
     /// Millimetres.
     Mm,
+    /// Inches (scanners sold in the US).
+    In,
 }
 
 impl Units {
-    /// Every unit, largest first.
-    pub const ALL: [Units; 4] = [Units::M, Units::Dm, Units::Cm, Units::Mm];
+    /// Every unit: the metric ones largest first, then inches (the order in which detection
+    /// prefers them).
+    pub const ALL: [Units; 5] = [Units::M, Units::Dm, Units::Cm, Units::Mm, Units::In];
 
-    /// The unit's symbol: `m`, `dm`, `cm` or `mm` (as files, JSON and the command line spell it).
+    /// The unit's symbol: `m`, `dm`, `cm`, `mm` or `in` (as files, JSON and the command line
+    /// spell it).
     pub fn symbol(self) -> &'static str {
         match self {
             Units::M => "m",
             Units::Dm => "dm",
             Units::Cm => "cm",
             Units::Mm => "mm",
+            Units::In => "in",
         }
     }
 
@@ -62,14 +86,23 @@ impl Units {
             Units::Dm => 100.0,
             Units::Cm => 10.0,
             Units::Mm => 1.0,
+            Units::In => MM_PER_INCH,
         }
     }
 
-    /// The unit in which `height` is the height of a standing person (0.5-2.5 m).
-    pub fn from_height(height: f64) -> Option<Units> {
+    /// The units in which `height` is the height of a standing person (0.5-2.5 m), in the
+    /// order of [`Units::ALL`].
+    pub fn candidates(height: f64) -> impl Iterator<Item = Units> {
         Units::ALL
             .into_iter()
-            .find(|u| (PERSON_HEIGHT_MM.0..=PERSON_HEIGHT_MM.1).contains(&(height * u.mm())))
+            .filter(move |u| (PERSON_HEIGHT_MM.0..=PERSON_HEIGHT_MM.1).contains(&(height * u.mm())))
+    }
+
+    /// The unit of a scan `height` units tall: of the units that make it a standing person,
+    /// the first that makes it at least [`SMALLEST_CUSTOMER_MM`] tall, else the first.
+    pub fn from_height(height: f64) -> Option<Units> {
+        let customer = |u: &Units| height * u.mm() >= SMALLEST_CUSTOMER_MM;
+        Units::candidates(height).find(customer).or_else(|| Units::candidates(height).next())
     }
 }
 
@@ -149,7 +182,7 @@ pub struct FrameOptions {
 pub enum FrameError {
     /// The height matches no unit for a person.
     #[error(
-        "the body is {} units tall along {up}, which is 0.5-2.5 m in none of m, dm, cm, mm; \
+        "the body is {} units tall along {up}, which is 0.5-2.5 m in none of m, dm, cm, mm, in; \
          pass --units (and check --up)", crate::messages::number(*height)
     )]
     UnknownUnits {
@@ -294,6 +327,39 @@ impl CanonicalFrame {
         let top = mesh.positions.iter().map(|&p| frame.to_canonical(p).z).fold(0.0, f64::max);
         frame.height_mm = top;
         Ok(frame)
+    }
+
+    /// When the units were detected and another unit would also have made a standing person
+    /// (inches against centimetres or decimetres): which reading was taken, the other, and
+    /// how to choose it.
+    pub fn units_warning(&self) -> Option<String> {
+        if !self.units_detected {
+            return None;
+        }
+        let height = self.height_mm / self.units.mm();
+        let other = Units::candidates(height).find(|&u| u != self.units)?;
+        Some(format!(
+            "units: read as {} ({} mm tall); in {other} the body would be {} mm tall: pass \
+             --units {other} if that is right",
+            self.units,
+            crate::messages::number(self.height_mm.round()),
+            crate::messages::number((height * other.mm()).round()),
+        ))
+    }
+
+    /// For a message about a scan that could not be reconstructed: when the units were
+    /// detected and the body's size is unusual for a customer ([`USUAL_STATURE_MM`]) or
+    /// another unit would also make a person, the units assumed and how to override them.
+    pub fn units_hint(&self) -> Option<String> {
+        let usual = (USUAL_STATURE_MM.0..=USUAL_STATURE_MM.1).contains(&self.height_mm);
+        if !self.units_detected || (usual && self.units_warning().is_none()) {
+            return None;
+        }
+        Some(format!(
+            "read as {}, detected: {} mm tall; if wrong, pass --units",
+            self.units,
+            crate::messages::number(self.height_mm.round()),
+        ))
     }
 
     /// `facing` as an axis name when it is one (within 1 degree).
@@ -504,4 +570,31 @@ pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, Fra
         rotation,
         translation,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inches_are_read_where_centimetres_would_make_a_toddler() {
+        // A 1.70 m adult in each unit.
+        for unit in Units::ALL {
+            assert_eq!(Units::from_height(1700.0 / unit.mm()), Some(unit), "{unit}");
+        }
+        // 1.2-2.2 m adults in inches (47-87 units) are not centimetres.
+        for inches in [47.3, 60.0, 87.0] {
+            assert_eq!(Units::from_height(inches), Some(Units::In), "{inches}");
+        }
+        // The limit, as documented: a child under 1 m in centimetres reads as inches...
+        assert_eq!(Units::from_height(80.0), Some(Units::In));
+        // ... but not one of 1 m or more, nor where inches would be over 2.5 m.
+        assert_eq!(Units::from_height(110.0), Some(Units::Cm));
+        assert_eq!(Units::from_height(99.0), Some(Units::Cm));
+        // An inch scan of a child under 0.64 m reads as decimetres.
+        assert_eq!(Units::from_height(22.0), Some(Units::Dm));
+        // Where no unit makes a usual customer, the first that makes a person.
+        assert_eq!(Units::from_height(0.6), Some(Units::M));
+        assert_eq!(Units::from_height(3.0), None);
+    }
 }

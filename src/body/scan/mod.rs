@@ -46,6 +46,20 @@ pub struct Scan {
     pub carried: Option<CarriedBody>,
 }
 
+impl Scan {
+    /// The one-line error of this scan, which could not be processed because of `e`: the
+    /// file, and, when its units were detected and its size is unusual, the units assumed
+    /// and how to override them ([`CanonicalFrame::units_hint`]; first, as the likely
+    /// cause), then `e`.
+    pub fn failed(&self, e: impl std::fmt::Display) -> String {
+        let file = messages::path(&self.source);
+        match self.frame.units_hint() {
+            Some(hint) => format!("{file} ({hint}): {e}"),
+            None => format!("{file}: {e}"),
+        }
+    }
+}
+
 /// Why a scan could not be loaded. Every message starts with the file's name.
 #[derive(Debug, thiserror::Error)]
 pub enum ScanError {

@@ -29,7 +29,8 @@ pub struct PreparedScan {
     /// The scan, in the canonical frame, smoothed where [`Self::smoothed`] says.
     pub scan: Scan,
     /// What the reader's cleaning found, then what the topology check found (holes,
-    /// manifoldness, orientation): always in that order.
+    /// manifoldness, orientation), then which units were read where another would also make
+    /// a person: always in that order.
     pub warnings: Vec<String>,
     /// Whether the body was smoothed (passes asked for, and not a mannequin dressform made).
     pub smoothed: bool,
@@ -55,6 +56,7 @@ impl PreparedScan {
     pub fn reduced(mut scan: Scan, passes: usize, max_triangles: Option<usize>) -> PreparedScan {
         let mut warnings = scan.cleaning.warnings();
         warnings.extend(topology(&scan.body).warnings());
+        warnings.extend(scan.frame.units_warning());
         if let Some((body, d)) = max_triangles.and_then(|max| decimate(&scan.body, max)) {
             scan.body = body;
             warnings.push(format!(
