@@ -20,8 +20,9 @@
 //! Commits into the folders of one parent are taken one at a time (a lock on the parent).
 //!
 //! Where folders cannot be swapped (another OS, a filesystem without the exchange, `out/` a
-//! mount point or the working directory, whose shell would be left in the old folder), each
-//! file is written atomically on its own and the list last: every file whole, the set not.
+//! mount point, or the working directory or one of its parents: a shell inside would be left in
+//! the old folder), each file is written atomically on its own and the list last: every file
+//! whole, the set not.
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -147,9 +148,9 @@ impl OutputSet {
         for left in siblings(parent, &prefix) {
             retire(&left, &real)?;
         }
-        // A shell working in `dir` would be left in the old folder by a swap.
+        // A shell working in `dir` (or a folder in it) would be left in the old folder by a swap.
         let working_dir = std::env::current_dir().and_then(|d| d.canonicalize()).ok();
-        if working_dir.as_ref() != Some(&real)
+        if !working_dir.is_some_and(|w| w.starts_with(&real))
             && let Ok(sibling) = beside(parent, &prefix, &real)
         {
             let swapped = swap(&self.files, dir, &real, &sibling);

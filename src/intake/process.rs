@@ -8,6 +8,7 @@
 use super::hash::Fnv1a;
 use super::jobs::ScanJob;
 use super::landmarks::{self, LandmarksFile};
+use super::summary::{Row, Status};
 use crate::body::mesh::decimate::WORKING_TRIANGLES;
 use crate::body::scan::format::{Export, Format};
 use crate::body::scan::frame::Units;
@@ -227,4 +228,18 @@ fn measures(done: &Reshaped) -> BTreeMap<String, Option<f64>> {
         }
     }
     m
+}
+
+/// A summary row is made from what processing a scan came to, here where that is defined
+/// (the summary itself knows nothing of processing).
+impl Row {
+    /// The row of `customer`'s scan, processed in `seconds` to `outcome` (or an error).
+    pub fn new(customer: &str, outcome: &Result<Outcome, String>, seconds: f64) -> Row {
+        let (status, measures, error) = match outcome {
+            Ok(Outcome::Done(r, _)) => (Status::Done, r.measures.clone(), String::new()),
+            Ok(Outcome::Skipped(r)) => (Status::Skipped, r.measures.clone(), String::new()),
+            Err(e) => (Status::Failed, BTreeMap::new(), messages::bounded(e)),
+        };
+        Row { customer: customer.to_string(), status, measures, seconds, error }
+    }
 }

@@ -5,7 +5,6 @@
 //! bilateral ones in two columns; empty where not measured), `seconds` (wall time) and
 //! `error` (one line, for `failed`). Written atomically; [`merge`] joins shards' summaries.
 
-use super::process::Outcome;
 use crate::atomic_output::write_atomically;
 use crate::messages;
 use crate::run::report::definitions::DEFINITIONS;
@@ -66,18 +65,6 @@ pub struct Row {
     pub seconds: f64,
     /// The one-line error of a failed scan.
     pub error: String,
-}
-
-impl Row {
-    /// The row of `customer`'s scan, processed in `seconds` to `outcome` (or an error).
-    pub fn new(customer: &str, outcome: &Result<Outcome, String>, seconds: f64) -> Row {
-        let (status, measures, error) = match outcome {
-            Ok(Outcome::Done(r, _)) => (Status::Done, r.measures.clone(), String::new()),
-            Ok(Outcome::Skipped(r)) => (Status::Skipped, r.measures.clone(), String::new()),
-            Err(e) => (Status::Failed, BTreeMap::new(), messages::bounded(e)),
-        };
-        Row { customer: customer.to_string(), status, measures, seconds, error }
-    }
 }
 
 /// The summary's columns, in order.
