@@ -33,7 +33,7 @@ pub struct Decimation {
     pub error: f64,
 }
 
-/// `mesh` reduced to at most `target` triangles (fewer where [`MAX_ERROR`] stops it), or `None`
+/// `mesh` reduced to at most `target` triangles (fewer where `MAX_ERROR` stops it), or `None`
 /// when it has no more than that.
 pub fn decimate(mesh: &Mesh, target: usize) -> Option<(Mesh, Decimation)> {
     if mesh.triangles.len() <= target {
@@ -88,7 +88,8 @@ fn drop_folded_pairs(triangles: &mut Vec<[u32; 3]>) {
 }
 
 /// The mesh of `triangles` over `positions`, with only the vertices they use, in their first
-/// use's order.
+/// use's order. Not [`Mesh::drop_unused_vertices`]: that works on a mesh that owns its
+/// positions, and a copy of the scan's 2.4M would land on the decimation's memory peak.
 fn compact(positions: &[DVec3], triangles: &[[u32; 3]]) -> Mesh {
     let mut new_index = vec![u32::MAX; positions.len()];
     let mut out = Mesh::default();
