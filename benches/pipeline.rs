@@ -106,6 +106,7 @@ fn benches(c: &mut Criterion) {
     std::fs::write(&ply, Format::Ply.encode(&million)).expect("write the PLY");
     let list: Vec<String> = planes(height, 200).iter().map(|h| format!("{h:.2}")).collect();
     let list = list.join(",");
+    stage_benches(&mut group, &ply, &planes(height, 200));
     group.measurement_time(Duration::from_secs(10));
     group.bench_function(
         format!("dressform slice process, {} triangles, 200 planes", million.triangles.len()),
@@ -126,6 +127,48 @@ fn benches(c: &mut Criterion) {
         },
     );
     group.finish();
+}
+
+/// The stages of the whole `dressform slice` process one by one (issue 36), on the same file
+/// and planes, so that a regression shows in the stage it is in: decoding the PLY, cleaning,
+/// the canonical frame, the topology check (beside the rest in the process), the sweep of the
+/// tracking levels and the requested planes, and the region tracking with that sweep.
+fn stage_benches(
+    group: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>,
+    ply: &std::path::Path,
+    heights: &[f64],
+) {
+    use criterion::BatchSize;
+    use dressform::body::mesh::topology;
+    use dressform::body::regions::{BodyRegions, TRACKING_STEP_MM};
+    use dressform::body::scan::{clean::clean, frame::detect};
+    let bytes = std::fs::read(ply).expect("read the PLY");
+    let read = Format::Ply.decode(&bytes).expect("decode the PLY").mesh;
+    let n = read.triangles.len();
+    group.bench_function(format!("slice stage: decode the PLY, {n} triangles"), |b| {
+        b.iter(|| Format::Ply.decode(&bytes).expect("decode"))
+    });
+    group.bench_function(format!("slice stage: clean, {n} triangles"), |b| {
+        b.iter_batched(|| read.clone(), |m| clean(m).expect("clean"), BatchSize::LargeInput)
+    });
+    let scan = scan::from_mesh(read.clone(), ply, &FrameOptions::default()).expect("the body");
+    group.bench_function(format!("slice stage: canonical frame, {n} triangles"), |b| {
+        b.iter(|| detect(&read, &FrameOptions::default()).expect("a frame"))
+    });
+    group.bench_function(format!("slice stage: topology check, {n} triangles"), |b| {
+        b.iter(|| topology(&scan.body))
+    });
+    let step = TRACKING_STEP_MM;
+    let levels = (scan.frame.height_mm / step).floor() as usize;
+    let tracking: Vec<f64> = (0..levels).map(|i| step * (i as f64 + 0.5)).collect();
+    let all = [&tracking[..], heights].concat();
+    group.bench_function(
+        format!("slice stage: sweep of {} tracking levels and {} planes", levels, heights.len()),
+        |b| b.iter(|| sections(&scan.body, &all)),
+    );
+    group.bench_function("slice stage: regions (the sweep and the tracking)", |b| {
+        b.iter(|| BodyRegions::find_and_cut(&scan.body, step, heights))
+    });
 }
 
 /// `reconstruct` (issue 15: a scan of about 300k triangles, the whole process <= 3 s, the fit

@@ -34,16 +34,6 @@ impl<'a> SegmentedBody<'a> {
         Ok(Self::owning(mesh, BodyRegions::find(mesh, TRACKING_STEP_MM)?))
     }
 
-    /// [`Self::find`], and the sections of `mesh` at `heights`, cut in the same sweep as the
-    /// tracking levels (returned whether or not segmentation succeeds).
-    pub fn find_and_cut(
-        mesh: &'a Mesh,
-        heights: &[f64],
-    ) -> (Result<SegmentedBody<'a>, RegionError>, Vec<Section>) {
-        let (regions, cut) = BodyRegions::find_and_cut(mesh, TRACKING_STEP_MM, heights);
-        (regions.map(|r| Self::owning(mesh, r)), cut)
-    }
-
     /// A body without arms and head whose `landmarks` are known (a mannequin dressform made,
     /// whose file carries them): see [`BodyRegions::armless`].
     pub fn armless(mesh: &'a Mesh, landmarks: Landmarks) -> SegmentedBody<'a> {

@@ -1,9 +1,9 @@
 //! `dressform slice <mesh> --heights 900,950,... [--json]`.
 
 use super::{Failure, FrameArgs, print_warnings, warn};
-use dressform::body::regions::Region;
+use dressform::body::regions::{BodyRegions, Region, TRACKING_STEP_MM};
 use dressform::body::scan::{self, ScanOptions};
-use dressform::body::segmented_body::SegmentedBody;
+use dressform::body::slice::sections;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -54,20 +54,20 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
     }
     let options =
         ScanOptions { frame: args.frame.options(), smooth: args.smooth, max_triangles: None };
-    let scan::PreparedScan { scan, warnings, .. } =
-        scan::prepare(&args.mesh, &options).map_err(Failure::bad_input)?;
-    let file = scan.source.display().to_string();
-    print_warnings(&file, &warnings, None);
-    let (body, sections) = match scan.carried {
-        // A mannequin dressform made: labelled by the landmarks its file carries.
-        Some(carried) => {
-            let body = SegmentedBody::armless(&scan.body, carried.landmarks);
-            let sections = body.sections(&args.heights);
-            (Ok(body), sections)
+    // Segmentation and the sections run while the scan's topology is checked.
+    let (prepared, (regions, sections)) = scan::prepare_then(&args.mesh, &options, |scan| {
+        match &scan.carried {
+            // A mannequin dressform made: labelled by the landmarks its file carries.
+            Some(carried) => {
+                (Ok(BodyRegions::armless(carried.landmarks)), sections(&scan.body, &args.heights))
+            }
+            None => BodyRegions::find_and_cut(&scan.body, TRACKING_STEP_MM, &args.heights),
         }
-        None => SegmentedBody::find_and_cut(&scan.body, &args.heights),
-    };
-    let body = body.map_err(|e| warn(&file, &format!("loops are not labelled: {e}"))).ok();
+    })
+    .map_err(Failure::bad_input)?;
+    let file = prepared.scan.source.display().to_string();
+    print_warnings(&file, &prepared.warnings, None);
+    let regions = regions.map_err(|e| warn(&file, &format!("loops are not labelled: {e}"))).ok();
     for s in sections.iter().filter(|s| s.bridged_gaps > 0) {
         warn(
             &file,
@@ -82,7 +82,7 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
         sections: sections
             .into_par_iter()
             .map(|s| {
-                let labels = body.as_ref().map(|b| b.regions().label(&s));
+                let labels = regions.as_ref().map(|r| r.label(&s));
                 SectionOut {
                     z_mm: s.height,
                     bridged_gaps: s.bridged_gaps,

@@ -78,7 +78,7 @@ impl Mesh {
     /// triangle that does not. The readers' boundary: every decoded file passes here.
     pub fn try_new(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Result<Self, BadIndex> {
         let vertices = positions.len();
-        let bad = triangles.iter().enumerate().find_map(|(triangle, t)| {
+        let bad = triangles.par_iter().enumerate().find_map_first(|(triangle, t)| {
             let index = *t.iter().find(|&&i| i as usize >= vertices)?;
             Some(BadIndex { triangle, index, vertices })
         });

@@ -58,50 +58,42 @@ impl Topology {
     }
 }
 
-/// Half-edge `h` runs from corner `h % 3` to the next corner of triangle `h / 3`.
-fn half_edge(mesh: &Mesh, h: usize) -> (u32, u32) {
-    let tri = mesh.triangles[h / 3];
-    (tri[h % 3], tri[(h + 1) % 3])
+/// Whether triangle `tri` runs from `a` to `b` (has the half-edge a -> b).
+fn runs(tri: [u32; 3], a: u32, b: u32) -> bool {
+    (0..3).any(|k| tri[k] == a && tri[(k + 1) % 3] == b)
 }
 
-/// Analyses the edges of `mesh` in linear time: half-edges are grouped by their lower vertex
-/// (a counting sort), and within each small group by their upper vertex; vertex ranges are
-/// processed in parallel.
+/// What one vertex adds to the topology: the edges it owns (those to higher-numbered
+/// vertices), the boundary half-edges among them, and whether its triangles form more than
+/// one fan.
+#[derive(Default)]
+struct Scratch {
+    /// `other corner << 32 | index in the vertex's triangle list`, for every triangle at the
+    /// vertex (packed: one integer sort).
+    corners: Vec<u64>,
+    /// Union-find parents over the vertex's triangles.
+    parent: Vec<u32>,
+}
+
+/// Analyses the edges of `mesh` in linear time from one incidence table (the triangles round
+/// each vertex, a counting sort): each vertex sorts its triangles' other corners, so that
+/// the triangles sharing an edge come together; that classifies the edges it owns (to a
+/// higher-numbered vertex: each edge once) and links its fans. Vertex ranges run in parallel.
+/// Triangles with a repeated corner (which cleaning drops) add no edge at that corner.
 pub fn topology(mesh: &Mesh) -> Topology {
-    let by_vertex = Incidence::half_edges_by_lower_vertex(mesh);
     let around = Incidence::triangles(mesh);
     let n = mesh.positions.len();
     let chunk = n.div_ceil(rayon::current_num_threads() * 8).max(1024);
-    let parts: Vec<(Topology, Vec<(u32, u32)>)> = (0..n.div_ceil(chunk))
+    let parts: Vec<Part> = (0..n.div_ceil(chunk))
         .into_par_iter()
         .map(|c| {
             let mut topo = Topology::default();
             let mut boundary = Vec::new();
-            let mut group: Vec<(u32, u32)> = Vec::new();
-            let (mut scratch, mut parent) = (Vec::new(), Vec::new());
+            let mut scratch = Scratch::default();
             for v in c * chunk..((c + 1) * chunk).min(n) {
-                group.clear();
-                group.extend(by_vertex.of(v).iter().map(|&h| {
-                    let (a, b) = half_edge(mesh, h as usize);
-                    (a.max(b), h)
-                }));
-                group.sort_unstable();
-                for run in group.chunk_by(|x, y| x.0 == y.0) {
-                    topo.edges += 1;
-                    match run {
-                        [(_, h)] => {
-                            topo.boundary_edges += 1;
-                            boundary.push(half_edge(mesh, *h as usize));
-                        }
-                        [(_, h1), (_, h2)] => {
-                            if half_edge(mesh, *h1 as usize) == half_edge(mesh, *h2 as usize) {
-                                topo.misoriented_edges += 1;
-                            }
-                        }
-                        _ => topo.non_manifold_edges += 1,
-                    }
-                }
-                if fans(mesh, v as u32, around.of(v), &mut scratch, &mut parent) > 1 {
+                let fans =
+                    vertex(mesh, v as u32, around.of(v), &mut scratch, &mut topo, &mut boundary);
+                if fans > 1 {
                     topo.non_manifold_vertices += 1;
                 }
             }
@@ -122,24 +114,35 @@ pub fn topology(mesh: &Mesh) -> Topology {
     topo
 }
 
-/// How many fans the triangles around vertex `v` form: triangles are in one fan when they
-/// are linked through edges at `v` (sharing `v` and one more vertex). Sorting the triangles'
-/// other corners brings the ones sharing an edge together, so a vertex of degree d costs
+/// What one range of vertices adds: its counts and its boundary half-edges.
+type Part = (Topology, Vec<(u32, u32)>);
+
+/// Vertex `v` with its `triangles` (in increasing order): classifies the edges from `v` to
+/// higher-numbered vertices into `topo` (boundary half-edges, in the direction their
+/// triangle runs, to `boundary`) and returns how many fans the triangles form: triangles are
+/// in one fan when they are linked through edges at `v`. Sorting the triangles' other
+/// corners brings the ones sharing an edge together, so a vertex of degree d costs
 /// O(d log d), not the O(d²) of comparing every pair (a million-triangle fan round one vertex
-/// is a valid mesh). `scratch` and `parent` are reused between vertices.
-fn fans(
+/// is a valid mesh).
+fn vertex(
     mesh: &Mesh,
     v: u32,
     triangles: &[u32],
-    scratch: &mut Vec<(u32, u32)>,
-    parent: &mut Vec<u32>,
+    scratch: &mut Scratch,
+    topo: &mut Topology,
+    boundary: &mut Vec<(u32, u32)>,
 ) -> usize {
-    scratch.clear();
+    let Scratch { corners, parent } = scratch;
+    corners.clear();
     for (i, &t) in triangles.iter().enumerate() {
+        // A triangle is listed once per corner at `v`: only a degenerate one twice.
+        if i > 0 && triangles[i - 1] == t {
+            continue;
+        }
         let others = mesh.triangles[t as usize].into_iter().filter(|&x| x != v);
-        scratch.extend(others.map(|x| (x, i as u32)));
+        corners.extend(others.map(|x| u64::from(x) << 32 | i as u64));
     }
-    scratch.sort_unstable();
+    corners.sort_unstable();
     parent.clear();
     parent.extend(0..triangles.len() as u32);
     fn root(parent: &mut [u32], mut i: u32) -> u32 {
@@ -149,13 +152,33 @@ fn fans(
         }
         i
     }
-    for run in scratch.chunk_by(|a, b| a.0 == b.0) {
+    let tri = |i: u32| mesh.triangles[triangles[i as usize] as usize];
+    let corner = |k: u64| (k >> 32) as u32;
+    let index = |k: u64| k as u32;
+    for run in corners.chunk_by(|&a, &b| corner(a) == corner(b)) {
+        let x = corner(run[0]);
+        if x > v {
+            topo.edges += 1;
+            match *run {
+                [i] => {
+                    topo.boundary_edges += 1;
+                    boundary.push(if runs(tri(index(i)), v, x) { (v, x) } else { (x, v) });
+                }
+                [i, j] => {
+                    if runs(tri(index(i)), v, x) == runs(tri(index(j)), v, x) {
+                        topo.misoriented_edges += 1;
+                    }
+                }
+                _ => topo.non_manifold_edges += 1,
+            }
+        }
         for pair in run.windows(2) {
-            let (a, b) = (root(parent, pair[0].1), root(parent, pair[1].1));
+            let (a, b) = (root(parent, index(pair[0])), root(parent, index(pair[1])));
             parent[a as usize] = b;
         }
     }
-    (0..triangles.len() as u32).filter(|&i| root(parent, i) == i).count()
+    let listed = |i: &u32| *i == 0 || triangles[*i as usize - 1] != triangles[*i as usize];
+    (0..triangles.len() as u32).filter(|i| listed(i) && root(parent, *i) == *i).count()
 }
 
 /// Chains directed boundary edges into loops. Where several boundary edges leave one vertex

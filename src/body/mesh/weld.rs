@@ -12,7 +12,7 @@ use std::hash::{Hash, Hasher};
 /// of them; returns how many were merged away. When some were, vertices no triangle uses are
 /// dropped too.
 ///
-/// A parallel sort of `hash << 32 | index` keys brings equal positions together (in index
+/// A radix sort of `hash << 32 | index` keys by hash brings equal positions together (in index
 /// order); only runs of equal hashes (duplicates, and rare collisions) are compared
 /// coordinate by coordinate.
 pub(super) fn weld_identical(mesh: &mut Mesh) -> usize {
@@ -26,7 +26,8 @@ pub(super) fn weld_identical(mesh: &mut Mesh) -> usize {
         .into_par_iter()
         .map(|i| hash(i) << 32 | u64::from(i))
         .collect();
-    keys.par_sort_unstable();
+    // By hash, stably: equal hashes stay in index order (the order of the whole keys).
+    radsort::sort_by_key(&mut keys, |k| (k >> 32) as u32);
     let mut remap: Vec<u32> = Vec::new();
     let mut merged = 0;
     for run in keys.chunk_by(|a, b| a >> 32 == b >> 32).filter(|run| run.len() > 1) {

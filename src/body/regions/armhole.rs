@@ -97,51 +97,69 @@ impl Armhole {
 }
 
 /// The highest surface point at each lateral offset `u` (mm outward from `centre_x` on
-/// `side`) over `us`, among the triangles reaching above `z_min`: the upper edge of the front
-/// silhouette, as (height, y) per offset (`None` where no surface is there).
+/// `side`) over `us`, among the triangles of `body` listed in `upper` that reach above
+/// `z_min`: the upper edge of the front silhouette, as (height, y) per offset (`None` where
+/// no surface is there).
 fn silhouette_top(
     body: &Mesh,
+    upper: &[u32],
     centre_x: f64,
     side: f64,
     us: &[f64],
     z_min: f64,
 ) -> Vec<Option<(f64, f64)>> {
-    let mut top: Vec<Option<(f64, f64)>> = vec![None; us.len()];
     let (u0, step) = (us[0], PROFILE_STEP_MM);
     let lateral = |p: DVec3| side * (p.x - centre_x);
-    for t in 0..body.triangles.len() {
-        let c = body.corners(t);
-        if c.iter().all(|p| p.z < z_min) {
-            continue;
-        }
-        let u = c.map(lateral);
-        let (lo, hi) = (u[0].min(u[1]).min(u[2]), u[0].max(u[1]).max(u[2]));
-        let first = ((lo - u0) / step).ceil().max(0.0) as usize;
-        let last = (((hi - u0) / step).floor()).min(us.len() as f64 - 1.0);
-        if last < first as f64 {
-            continue;
-        }
-        for (b, slot) in top.iter_mut().enumerate().take(last as usize + 1).skip(first) {
-            let ub = us[b];
-            for k in 0..3 {
-                let (a, e) = ((c[k], u[k]), (c[(k + 1) % 3], u[(k + 1) % 3]));
-                if (a.1 - ub) * (e.1 - ub) > 0.0 || a.1 == e.1 {
-                    continue;
-                }
-                let p = a.0.lerp(e.0, (ub - a.1) / (e.1 - a.1));
-                if slot.is_none_or(|(z, _)| p.z > z) {
-                    *slot = Some((p.z, p.y));
+    let higher = |slot: &Option<(f64, f64)>, z: f64| slot.is_none_or(|(top, _)| z > top);
+    // In parallel over blocks of triangles, merged in order: the first highest point wins,
+    // as in one pass.
+    crate::body::mesh::reduce::fold(
+        upper.len(),
+        || vec![None; us.len()],
+        |mut top: Vec<Option<(f64, f64)>>, i| {
+            let c = body.corners(upper[i] as usize);
+            if c.iter().all(|p| p.z < z_min) {
+                return top;
+            }
+            let u = c.map(lateral);
+            let (lo, hi) = (u[0].min(u[1]).min(u[2]), u[0].max(u[1]).max(u[2]));
+            let first = ((lo - u0) / step).ceil().max(0.0) as usize;
+            let last = (((hi - u0) / step).floor()).min(us.len() as f64 - 1.0);
+            if last < first as f64 {
+                return top;
+            }
+            for (b, slot) in top.iter_mut().enumerate().take(last as usize + 1).skip(first) {
+                let ub = us[b];
+                for k in 0..3 {
+                    let (a, e) = ((c[k], u[k]), (c[(k + 1) % 3], u[(k + 1) % 3]));
+                    if (a.1 - ub) * (e.1 - ub) > 0.0 || a.1 == e.1 {
+                        continue;
+                    }
+                    let p = a.0.lerp(e.0, (ub - a.1) / (e.1 - a.1));
+                    if higher(slot, p.z) {
+                        *slot = Some((p.z, p.y));
+                    }
                 }
             }
-        }
-    }
-    top
+            top
+        },
+        |mut top, later| {
+            for (slot, l) in top.iter_mut().zip(later) {
+                if l.is_some_and(|(z, _)| higher(slot, z)) {
+                    *slot = l;
+                }
+            }
+            top
+        },
+    )
 }
 
 /// The shoulder point on `side` (+1 left, -1 right) of `body`, given its armpit, the torso's
-/// centre line `centre_x` and the neck's height (the silhouette above it is the head's).
+/// centre line `centre_x` and the neck's height (the silhouette above it is the head's);
+/// `upper` lists the triangles reaching the armpit's height or higher (or more).
 pub(super) fn shoulder_point(
     body: &Mesh,
+    upper: &[u32],
     side: f64,
     centre_x: f64,
     armpit: DVec3,
@@ -156,7 +174,7 @@ pub(super) fn shoulder_point(
     if us.is_empty() {
         return None;
     }
-    let top = silhouette_top(body, centre_x, side, &us, armpit.z);
+    let top = silhouette_top(body, upper, centre_x, side, &us, armpit.z);
     let point = |k: usize| top[k].map(|(z, y)| DVec3::new(centre_x + side * us[k], y, z));
     // Shoulder samples: on the surface, above the armpit, below the neck.
     let on_shoulder = |k: usize| top[k].is_some_and(|(z, _)| z > armpit.z && z < neck);

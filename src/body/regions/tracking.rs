@@ -18,7 +18,7 @@ fn loop_containing(s: &Section, p: DVec2) -> Option<usize> {
 /// as the pelvis just above the crotch of a leg held out), the one holding most of its points.
 fn continuing(s: &Section, prev: &Contour) -> Option<usize> {
     loop_containing(s, prev.centroid()).or_else(|| {
-        let held = |k: usize| prev.points.iter().filter(|&&p| s.loops[k].contains(p)).count();
+        let held = |k: usize| s.loops[k].count_inside(&prev.points);
         (0..s.loops.len()).map(|k| (held(k), k)).filter(|&(n, _)| n > 0).max().map(|(_, k)| k)
     })
 }
@@ -198,7 +198,7 @@ fn refine_outgrowth(
 
 /// Whether loop `a` overlaps loop `b` seen from above: a point of `a` lies inside `b`.
 fn overlaps(a: &Contour, b: &Contour) -> bool {
-    a.points.iter().any(|&p| b.contains(p))
+    b.holds_any(&a.points)
 }
 
 /// Where the torso is picked up, as a fraction of the height: between the crotch (the hip
@@ -422,8 +422,14 @@ pub(super) fn track(
     let ankle = ankle_level(&sections, grid, &legs);
 
     // Armholes: through each armpit and its shoulder point, facing sideways.
+    // The triangles reaching the lower armpit or higher: all either shoulder point looks at.
+    let lower_pit = left_pit.0.z.min(right_pit.0.z);
+    let upper: Vec<u32> = (0..body.triangles.len() as u32)
+        .into_par_iter()
+        .filter(|&t| body.corners(t as usize).iter().any(|p| p.z >= lower_pit))
+        .collect();
     let armhole = |(pit, contact): (DVec3, Option<Contact>), sign: f64, name: &'static str| {
-        let shoulder = armhole::shoulder_point(body, sign, centre_x, pit, neck)
+        let shoulder = armhole::shoulder_point(body, &upper, sign, centre_x, pit, neck)
             .ok_or(RegionError::NoShoulder { side: name, armpit: pit.z })?;
         let plate = Armhole::through(pit, shoulder, DVec3::NEG_Y, sign);
         Ok(contact.map_or(plate, |c| plate.with_contact(c)))

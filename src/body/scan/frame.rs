@@ -425,16 +425,57 @@ fn accumulate<const N: usize>(
     mesh: &Mesh,
     add: impl Fn(&mut [Moments; N], DVec3, f64) + Sync,
 ) -> [Moments; N] {
-    crate::body::mesh::reduce::fold(
-        mesh.triangles.len(),
-        || [Moments::default(); N],
-        |mut acc, t| {
+    // Each block adds into one accumulator in place (a fold that passes it by value copies
+    // the moments for every triangle).
+    let blocks = crate::body::mesh::reduce::blocks(mesh.triangles.len(), |range| {
+        let mut m = [Moments::default(); N];
+        for t in range {
             let [a, b, c] = mesh.triangles[t].map(|v| mesh.positions[v as usize]);
-            add(&mut acc, (a + b + c) / 3.0, 0.5 * (b - a).cross(c - a).length());
-            acc
-        },
-        |x, y| std::array::from_fn(|k| x[k].merge(y[k])),
-    )
+            add(&mut m, (a + b + c) / 3.0, 0.5 * (b - a).cross(c - a).length());
+        }
+        m
+    });
+    let merge = |x: [Moments; N], y: [Moments; N]| std::array::from_fn(|k| x[k].merge(y[k]));
+    blocks.into_iter().fold([Moments::default(); N], merge)
+}
+
+/// The surface's bands along an up direction, by fraction of the height: trunk (hips to
+/// shoulders), feet, shins; horizontal coordinates on the two other axes.
+struct Bands {
+    u: DVec3,
+    floor: f64,
+    height: f64,
+    e1: DVec3,
+    e2: DVec3,
+}
+
+impl Bands {
+    fn new(up: Direction, bounds: &Aabb) -> Bands {
+        let u = up.vector();
+        let (floor, top) =
+            (bounds.min.dot(u).min(bounds.max.dot(u)), bounds.min.dot(u).max(bounds.max.dot(u)));
+        let e1 = Direction { axis: (up.axis + 1) % 3, negative: false }.vector();
+        let e2 = Direction { axis: (up.axis + 2) % 3, negative: false }.vector();
+        Bands { u, floor, height: top - floor, e1, e2 }
+    }
+
+    /// Horizontal coordinates of `p`.
+    fn flat(&self, p: DVec3) -> DVec2 {
+        DVec2::new(p.dot(self.e1), p.dot(self.e2))
+    }
+
+    /// Adds a triangle (centroid `p`, area `a`) to the moments of its band: `m` holds trunk,
+    /// feet, shins.
+    fn add(&self, m: &mut [Moments], p: DVec3, a: f64) {
+        let f = (p.dot(self.u) - self.floor) / self.height;
+        let band = match f {
+            _ if (0.45..=0.75).contains(&f) => 0,
+            _ if f <= 0.04 => 1,
+            _ if (0.10..=0.25).contains(&f) => 2,
+            _ => return,
+        };
+        m[band].add(p, a, self.flat(p));
+    }
 }
 
 /// The smallest ratio of height to the largest horizontal extent of a standing person: arms
@@ -479,9 +520,17 @@ fn check_up(
 pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, FrameError> {
     let bounds =
         mesh.bounds().unwrap_or(crate::body::mesh::Aabb { min: DVec3::ZERO, max: DVec3::ZERO });
-    let [all] = accumulate(mesh, |m: &mut [Moments; 1], p, a| m[0].add(p, a, DVec2::ZERO));
-    let centroid = all.mean().unwrap_or(bounds.min);
     let axis = bounds.size().max_position();
+    // One pass for the centroid and, for the longest axis either way up, the bands' moments;
+    // a stated up along another axis takes a second pass for its bands.
+    let along = |negative: bool| Bands::new(Direction { axis, negative }, &bounds);
+    let (up_axis, down_axis) = (along(false), along(true));
+    let [all, rest @ ..] = accumulate(mesh, |m: &mut [Moments; 7], p, a| {
+        m[0].add(p, a, DVec2::ZERO);
+        up_axis.add(&mut m[1..4], p, a);
+        down_axis.add(&mut m[4..7], p, a);
+    });
+    let centroid = all.mean().unwrap_or(bounds.min);
     let detected_up =
         Direction { axis, negative: centroid[axis] < 0.5 * (bounds.min[axis] + bounds.max[axis]) };
     let up = match options.up {
@@ -491,10 +540,8 @@ pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, Fra
         }
         None => detected_up,
     };
-    let u = up.vector();
-    let (floor, top) =
-        (bounds.min.dot(u).min(bounds.max.dot(u)), bounds.min.dot(u).max(bounds.max.dot(u)));
-    let height = top - floor;
+    let bands = Bands::new(up, &bounds);
+    let (u, floor, height) = (up.vector(), bands.floor, bands.height);
     let units = match options.units {
         Some(units) => {
             let height_mm = height * units.mm();
@@ -514,21 +561,12 @@ pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, Fra
         None => Units::from_height(height).ok_or(FrameError::UnknownUnits { height, up })?,
     };
 
-    // Horizontal coordinates on the two other axes; bands by fraction of the height:
-    // trunk (hips to shoulders), feet, shins.
-    let e1 = Direction { axis: (up.axis + 1) % 3, negative: false }.vector();
-    let e2 = Direction { axis: (up.axis + 2) % 3, negative: false }.vector();
-    let flat = |p: DVec3| DVec2::new(p.dot(e1), p.dot(e2));
-    let [trunk, feet, shins] = accumulate(mesh, |m: &mut [Moments; 3], p, a| {
-        let f = (p.dot(u) - floor) / height;
-        let band = match f {
-            _ if (0.45..=0.75).contains(&f) => 0,
-            _ if f <= 0.04 => 1,
-            _ if (0.10..=0.25).contains(&f) => 2,
-            _ => return,
-        };
-        m[band].add(p, a, flat(p));
-    });
+    let [trunk, feet, shins] = match (up.axis == axis, up.negative) {
+        (true, false) => [rest[0], rest[1], rest[2]],
+        (true, true) => [rest[3], rest[4], rest[5]],
+        (false, _) => accumulate(mesh, |m: &mut [Moments; 3], p, a| bands.add(m, p, a)),
+    };
+    let flat = |p: DVec3| bands.flat(p);
     let centre = trunk.mean().unwrap_or(bounds.min);
     let c2 = flat(centre);
     let w = trunk.weight.max(f64::MIN_POSITIVE);
@@ -549,7 +587,7 @@ pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, Fra
         }
         None => {
             let forward = if evidence >= 0.0 { front_back } else { -front_back };
-            ((e1 * forward.x + e2 * forward.y).normalize(), true)
+            ((bands.e1 * forward.x + bands.e2 * forward.y).normalize(), true)
         }
     };
     let left = u.cross(facing);

@@ -39,8 +39,18 @@ pub struct PreparedScan {
 /// Reads the scan at `path` in the frame `options` give, gathers its warnings and smooths
 /// it (see [`PreparedScan::new`]).
 pub fn prepare(path: &Path, options: &ScanOptions) -> Result<PreparedScan, ScanError> {
+    Ok(prepare_then(path, options, |_| ())?.0)
+}
+
+/// [`prepare`], then `work` on the prepared scan while its topology is checked beside it (see
+/// [`PreparedScan::reduced_then`]).
+pub fn prepare_then<R: Send>(
+    path: &Path,
+    options: &ScanOptions,
+    work: impl FnOnce(&Scan) -> R + Send,
+) -> Result<(PreparedScan, R), ScanError> {
     let scan = load(path, &options.frame)?;
-    Ok(PreparedScan::reduced(scan, options.smooth, options.max_triangles))
+    Ok(PreparedScan::reduced_then(scan, options.smooth, options.max_triangles, work))
 }
 
 impl PreparedScan {
@@ -53,13 +63,32 @@ impl PreparedScan {
 
     /// [`Self::new`], the scan decimated to at most `max_triangles` between its warnings (which
     /// describe the scan as read) and the smoothing; a note says so.
-    pub fn reduced(mut scan: Scan, passes: usize, max_triangles: Option<usize>) -> PreparedScan {
-        let mut warnings = scan.cleaning.warnings();
-        warnings.extend(topology(&scan.body).warnings());
-        warnings.extend(scan.frame.units_warning());
-        if let Some((body, d)) = max_triangles.and_then(|max| decimate(&scan.body, max)) {
+    pub fn reduced(scan: Scan, passes: usize, max_triangles: Option<usize>) -> PreparedScan {
+        Self::reduced_then(scan, passes, max_triangles, |_| ()).0
+    }
+
+    /// [`Self::reduced`], then `work` on the prepared scan. The topology check (holes,
+    /// manifoldness, orientation: only a warning, and a pass over every vertex's fan) runs
+    /// beside the next step that reads the same triangles: the decimation where the scan is
+    /// decimated (the scan as read is then dropped before `work`), `work` otherwise (smoothing
+    /// moves vertices, never triangles, so the smoothed scan's topology is the scan's as read).
+    pub fn reduced_then<R: Send>(
+        mut scan: Scan,
+        passes: usize,
+        max_triangles: Option<usize>,
+        work: impl FnOnce(&Scan) -> R + Send,
+    ) -> (PreparedScan, R) {
+        let (checked, decimated) = match max_triangles {
+            Some(max) if scan.body.triangles.len() > max => {
+                let (t, d) = rayon::join(|| topology(&scan.body), || decimate(&scan.body, max));
+                (Some(t), d)
+            }
+            _ => (None, None),
+        };
+        let mut note = None;
+        if let Some((body, d)) = decimated {
             scan.body = body;
-            warnings.push(format!(
+            note = Some(format!(
                 "{} triangles, more than the pipeline needs: decimated to {} (largest deviation \
                  {:.1} mm)",
                 d.from_triangles, d.to_triangles, d.error
@@ -69,7 +98,17 @@ impl PreparedScan {
         if smoothed {
             scan.body.taubin_smooth(passes);
         }
-        PreparedScan { scan, warnings, smoothed }
+        let (checked, out) = match checked {
+            Some(t) => (t, work(&scan)),
+            // On a thread of its own: `work` keeps rayon's threads, and the check fills the
+            // cores its serial stretches leave idle.
+            None => rayon::join(|| topology(&scan.body), || work(&scan)),
+        };
+        let mut warnings = scan.cleaning.warnings();
+        warnings.extend(checked.warnings());
+        warnings.extend(scan.frame.units_warning());
+        warnings.extend(note);
+        (PreparedScan { scan, warnings, smoothed }, out)
     }
 }
 

@@ -14,8 +14,8 @@ pub struct Contour {
 impl Contour {
     /// The loop's edges as point pairs, including the closing edge.
     pub(crate) fn edges(&self) -> impl Iterator<Item = (DVec2, DVec2)> + '_ {
-        let n = self.points.len();
-        (0..n).map(move |i| (self.points[i], self.points[(i + 1) % n]))
+        let next = self.points.iter().skip(1).chain(self.points.first());
+        self.points.iter().copied().zip(next.copied())
     }
 
     /// Length of the contour itself (follows every concavity).
@@ -86,6 +86,30 @@ impl Contour {
     /// nearly so: crossings are interpolated linearly); the cuts become straight edges.
     pub fn keep_where(&self, side: impl Fn(DVec2) -> f64) -> Contour {
         Contour { points: clip_half_plane(&self.points, side) }
+    }
+
+    /// How many of `points` lie inside the loop ([`Self::contains`]); the loop's bounding box
+    /// is found once and the points outside it are not tested against every edge.
+    pub fn count_inside<'p>(&self, points: impl IntoIterator<Item = &'p DVec2>) -> usize {
+        self.inside(points).count()
+    }
+
+    /// Whether any of `points` lies inside the loop ([`Self::count_inside`]).
+    pub fn holds_any<'p>(&self, points: impl IntoIterator<Item = &'p DVec2>) -> bool {
+        self.inside(points).next().is_some()
+    }
+
+    /// Those of `points` inside the loop, the bounding box tested first.
+    fn inside<'p>(
+        &self,
+        points: impl IntoIterator<Item = &'p DVec2>,
+    ) -> impl Iterator<Item = &'p DVec2> {
+        let bounds = self.bounds();
+        points.into_iter().filter(move |&&p| {
+            bounds.is_some_and(|b| {
+                (b.min.x..=b.max.x).contains(&p.x) && (b.min.y..=b.max.y).contains(&p.y)
+            }) && self.contains(p)
+        })
     }
 
     /// Whether `p` lies inside the loop (even-odd rule).

@@ -52,12 +52,38 @@ pub(super) fn vertices(
         Ok(records) => records,
         Err(e) => return Some(Err(e)),
     };
-    let at = |r: &[u8], axis: usize| decode(&r[offsets[xyz[axis]]..], types[axis], big_endian);
-    let positions = records
-        .par_chunks_exact(size.max(1))
-        .map(|r| DVec3::new(at(r, 0), at(r, 1), at(r, 2)))
-        .collect();
+    let at = xyz.map(|k| offsets[k]);
+    // What scanners write (little-endian floats or doubles): one loop with nothing to decide
+    // per value; any other layout through the general decoder.
+    let positions = match (types, big_endian) {
+        ([Num::F32, Num::F32, Num::F32], false) => decode_records(records, size, |r, axis| {
+            f32::from_le_bytes(bytes_at(r, at[axis])).into()
+        }),
+        ([Num::F64, Num::F64, Num::F64], false) => {
+            decode_records(records, size, |r, axis| f64::from_le_bytes(bytes_at(r, at[axis])))
+        }
+        _ => {
+            decode_records(records, size, |r, axis| decode(&r[at[axis]..], types[axis], big_endian))
+        }
+    };
     Some(Ok(positions))
+}
+
+/// The `N` bytes at `at` in record `r` (zeros past its end: the layout keeps them inside).
+fn bytes_at<const N: usize>(r: &[u8], at: usize) -> [u8; N] {
+    r.get(at..).and_then(|b| b.first_chunk().copied()).unwrap_or([0; N])
+}
+
+/// Positions from vertex records of `size` bytes, `coordinate(record, axis)` each.
+fn decode_records(
+    records: &[u8],
+    size: usize,
+    coordinate: impl Fn(&[u8], usize) -> f64 + Sync,
+) -> Vec<DVec3> {
+    records
+        .par_chunks_exact(size.max(1))
+        .map(|r| DVec3::new(coordinate(r, 0), coordinate(r, 1), coordinate(r, 2)))
+        .collect()
 }
 
 /// The triangles of a face element whose one list (at `list`) holds integer vertex indices,
@@ -82,26 +108,41 @@ pub(super) fn triangles(
     }
     let big_endian = bytes.big_endian;
     let all = bytes.bytes.get(bytes.at..bytes.at.checked_add(element.count.checked_mul(size)?)?)?;
-    let triangle = |r: &[u8]| decode_integer(&r[length_at..], length_type, big_endian) == 3;
-    if !all.par_chunks_exact(size).all(triangle) {
-        return None;
-    }
-    bytes.at += all.len();
     let first = length_at + length_type.size();
-    let raw = |r: &[u8], k: usize| {
-        decode_integer(&r[first + k * index_type.size()..], index_type, big_endian)
+    let decoded = match (length_type, index_type, big_endian) {
+        // What scanners write (a byte count, 32-bit indices, little-endian): nothing to decide
+        // per value.
+        (Num::U8, Num::U32 | Num::I32, false) => {
+            let signed = index_type == Num::I32;
+            let raw = |r: &[u8], k: usize| {
+                let b = bytes_at(r, first + 4 * k);
+                if signed { i32::from_le_bytes(b).into() } else { u32::from_le_bytes(b).into() }
+            };
+            check_and_decode(all, size, |r| r.get(length_at) == Some(&3), raw, vertices)
+        }
+        _ => {
+            let triangle = |r: &[u8]| decode_integer(&r[length_at..], length_type, big_endian) == 3;
+            let raw = |r: &[u8], k: usize| {
+                decode_integer(&r[first + k * index_type.size()..], index_type, big_endian)
+            };
+            check_and_decode(all, size, triangle, raw, vertices)
+        }
     };
-    Some(check_and_decode(all, size, raw, vertices))
+    if decoded.is_some() {
+        bytes.at += all.len();
+    }
+    decoded
 }
 
-/// Decodes triangle records in parallel; one pass decodes and checks, a bad index is only
-/// located (for the message) afterwards.
+/// Decodes triangle records in parallel, `None` where some record is not a `triangle`; one
+/// pass decodes and checks, a bad index is only located (for the message) afterwards.
 fn check_and_decode(
     all: &[u8],
     size: usize,
+    triangle: impl Fn(&[u8]) -> bool + Sync,
     raw: impl Fn(&[u8], usize) -> i64 + Sync,
     vertices: usize,
-) -> Result<Vec<[u32; 3]>, ReadError> {
+) -> Option<Result<Vec<[u32; 3]>, ReadError>> {
     let in_range = |i: i64| usize::try_from(i).is_ok_and(|i| i < vertices);
     let bad = AtomicBool::new(false);
     let index = |r: &[u8], k: usize| {
@@ -113,14 +154,26 @@ fn check_and_decode(
             u32::MAX
         }
     };
-    let triangles: Vec<[u32; 3]> =
-        all.par_chunks_exact(size).map(|r| [index(r, 0), index(r, 1), index(r, 2)]).collect();
+    // Collected by index (a collect into `Option<Vec>` loses the length and gathers pieces).
+    let other = AtomicBool::new(false);
+    let triangles: Vec<[u32; 3]> = all
+        .par_chunks_exact(size)
+        .map(|r| {
+            if !triangle(r) {
+                other.store(true, Ordering::Relaxed);
+            }
+            [index(r, 0), index(r, 1), index(r, 2)]
+        })
+        .collect();
+    if other.load(Ordering::Relaxed) {
+        return None;
+    }
     if bad.load(Ordering::Relaxed) {
         for (face, r) in all.chunks_exact(size).enumerate() {
             if let Some(index) = (0..3).map(|k| raw(r, k)).find(|&i| !in_range(i)) {
-                return Err(ReadError::IndexOutOfRange { face, index, vertices });
+                return Some(Err(ReadError::IndexOutOfRange { face, index, vertices }));
             }
         }
     }
-    Ok(triangles)
+    Some(Ok(triangles))
 }
