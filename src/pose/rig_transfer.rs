@@ -101,10 +101,17 @@ pub fn transfer(
         .positions
         .par_iter()
         .zip(&scan_normals)
-        .map(|(&p, &n)| {
+        .map_init(Vec::new, |seen: &mut Vec<u32>, (&p, &n)| {
             let mut best = (f64::INFINITY, 0usize, [1.0, 0.0, 0.0]);
+            seen.clear();
             for hit in tree.nearest_n::<SquaredEuclidean>(&p.to_array(), CANDIDATE_VERTICES) {
+                // A triangle around two candidates is measured once (the first time: a
+                // repeat, no nearer, would not replace it).
                 for &t in &around[hit.item as usize] {
+                    if seen.contains(&t) {
+                        continue;
+                    }
+                    seen.push(t);
                     let corners = model.corners(t as usize);
                     let bary = closest_on_triangle(p, corners);
                     let q = bary[0] * corners[0] + bary[1] * corners[1] + bary[2] * corners[2];
@@ -135,28 +142,79 @@ pub fn transfer(
 /// Fills the untrusted vertices' weights from their neighbours (see the module documentation);
 /// returns how many were filled. A piece of the scan with no trusted vertex keeps its own
 /// closest-triangle weights.
+///
+/// The sweeps run on a compact copy: only the filled vertices and their neighbours, only the
+/// bones any of them weighs (a bone none of them weighs stays zero in every mean).
 fn inpaint(scan: &Mesh, weights: &mut [Vec<f64>], trusted: &[bool]) -> usize {
-    let n = scan.positions.len();
-    let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n];
-    for tri in &scan.triangles {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            neighbours[a as usize].push(b);
-            neighbours[b as usize].push(a);
+    let neighbours = Neighbours::new(scan);
+    let (order, round) = fill_order(&neighbours, trusted);
+    if order.is_empty() {
+        return 0;
+    }
+    // The vertices the means read, the filled ones first (slot i is order[i]).
+    let mut slot = vec![u32::MAX; scan.positions.len()];
+    let mut vertices = order.clone();
+    order.iter().enumerate().for_each(|(i, &v)| slot[v] = i as u32);
+    for &v in &order {
+        for &u in neighbours.of(v) {
+            if slot[u as usize] == u32::MAX {
+                slot[u as usize] = vertices.len() as u32;
+                vertices.push(u as usize);
+            }
         }
     }
-    // Breadth first from the trusted vertices: each untrusted one starts as the mean of the
+    let bones: Vec<usize> = (0..weights[order[0]].len())
+        .filter(|&b| vertices.iter().any(|&v| weights[v][b] != 0.0))
+        .collect();
+    let width = bones.len();
+    let mut local: Vec<f64> = vertices
+        .iter()
+        .flat_map(|&v| {
+            let w = &weights[v];
+            bones.iter().map(move |&b| w[b])
+        })
+        .collect();
+    let mut mean = vec![0.0; width];
+    let mut sweep = |local: &mut Vec<f64>, usable: &dyn Fn(usize, usize) -> bool| {
+        for (i, &v) in order.iter().enumerate() {
+            mean.fill(0.0);
+            let mut count = 0.0;
+            for &u in neighbours.of(v).iter().filter(|&&u| usable(v, u as usize)) {
+                let at = slot[u as usize] as usize * width;
+                mean.iter_mut().zip(&local[at..at + width]).for_each(|(a, b)| *a += b);
+                count += 1.0;
+            }
+            // Every filled vertex has a neighbour filled in an earlier round or trusted.
+            mean.iter_mut().for_each(|a| *a /= count);
+            local[i * width..(i + 1) * width].copy_from_slice(&mean);
+        }
+    };
+    // Breadth first from the trusted vertices: each filled one starts as the mean of the
     // neighbours reached in earlier rounds, so the sweeps begin close to the solution.
+    sweep(&mut local, &|v, u| round[u] < round[v]);
+    for _ in 0..FILL_SWEEPS {
+        sweep(&mut local, &|_, _| true);
+    }
+    for (i, &v) in order.iter().enumerate() {
+        bones.iter().enumerate().for_each(|(j, &b)| weights[v][b] = local[i * width + j]);
+    }
+    order.len()
+}
+
+/// The vertices the inpainting fills, in the order it fills them (breadth first from the
+/// trusted vertices, round by round), and each vertex's round (0 for the trusted ones,
+/// `usize::MAX` for those never reached).
+fn fill_order(neighbours: &Neighbours, trusted: &[bool]) -> (Vec<usize>, Vec<usize>) {
+    let n = trusted.len();
     let mut round: Vec<usize> = trusted.iter().map(|&t| if t { 0 } else { usize::MAX }).collect();
     let mut front: Vec<usize> = (0..n).filter(|&v| trusted[v]).collect();
     let mut order = Vec::new();
-    let mut mean = vec![0.0; weights.first().map_or(0, Vec::len)];
     let mut r = 0;
     while !front.is_empty() {
         r += 1;
         let mut next = Vec::new();
         for &v in &front {
-            for &u in &neighbours[v] {
+            for &u in neighbours.of(v) {
                 let u = u as usize;
                 if round[u] == usize::MAX {
                     round[u] = r;
@@ -164,42 +222,52 @@ fn inpaint(scan: &Mesh, weights: &mut [Vec<f64>], trusted: &[bool]) -> usize {
                 }
             }
         }
-        for &u in &next {
-            if mean_of(&neighbours[u], weights, |x| round[x] < r, &mut mean) {
-                weights[u].copy_from_slice(&mean);
-            }
-        }
         order.extend_from_slice(&next);
         front = next;
     }
-    for _ in 0..FILL_SWEEPS {
-        for &v in &order {
-            if mean_of(&neighbours[v], weights, |_| true, &mut mean) {
-                weights[v].copy_from_slice(&mean);
-            }
-        }
-    }
-    order.len()
+    (order, round)
 }
 
-/// The mean weights of the `neighbours` that `usable` accepts, into `mean` (as long as a
-/// vertex's weights); whether there was any.
-fn mean_of(
-    neighbours: &[u32],
-    weights: &[Vec<f64>],
-    usable: impl Fn(usize) -> bool,
-    mean: &mut [f64],
-) -> bool {
-    mean.fill(0.0);
-    let mut count = 0.0;
-    for &u in neighbours.iter().filter(|&&u| usable(u as usize)) {
-        mean.iter_mut().zip(&weights[u as usize]).for_each(|(a, b)| *a += b);
-        count += 1.0;
+/// Each vertex's neighbours along the triangles' edges, in triangle order (an edge two
+/// triangles share listed twice), in one array: the means add them in this order.
+struct Neighbours {
+    /// Where each vertex's neighbours start in `list` (one more entry than vertices).
+    offsets: Vec<usize>,
+    /// The neighbours of every vertex, one after the other.
+    list: Vec<u32>,
+}
+
+impl Neighbours {
+    /// Each edge of each triangle both ways, in triangle order.
+    fn edges(scan: &Mesh) -> impl Iterator<Item = (u32, u32)> + '_ {
+        scan.triangles.iter().flat_map(|tri| {
+            (0..3).flat_map(move |k| {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                [(a, b), (b, a)]
+            })
+        })
     }
-    if count > 0.0 {
-        mean.iter_mut().for_each(|a| *a /= count);
+
+    /// The neighbours of `scan`'s vertices.
+    fn new(scan: &Mesh) -> Self {
+        let mut offsets = vec![0; scan.positions.len() + 1];
+        Self::edges(scan).for_each(|(a, _)| offsets[a as usize + 1] += 1);
+        for v in 0..scan.positions.len() {
+            offsets[v + 1] += offsets[v];
+        }
+        let mut list = vec![0; offsets[scan.positions.len()]];
+        let mut next = offsets.clone();
+        for (a, b) in Self::edges(scan) {
+            list[next[a as usize]] = b;
+            next[a as usize] += 1;
+        }
+        Neighbours { offsets, list }
     }
-    count > 0.0
+
+    /// The neighbours of vertex `v`.
+    fn of(&self, v: usize) -> &[u32] {
+        &self.list[self.offsets[v]..self.offsets[v + 1]]
+    }
 }
 
 /// Each vertex's strongest bones (at most `MAX_INFLUENCES`) as multiples of `WEIGHT_QUANTUM`

@@ -30,6 +30,10 @@ use crate::run::preview::{form_fit_png, preview_png, sections_svg};
 use crate::run::reconstruct::{AsScanned, MeasurementsReport, Reposed};
 use crate::run::report::{self, Figure, FitTestPart, FormPart, Measured, Report, SweepPart};
 use form_description::FormDescription;
+use rayon::prelude::*;
+
+/// Makes one file's bytes.
+type Job<'a> = Box<dyn FnOnce() -> Result<Vec<u8>, serde_json::Error> + Send + 'a>;
 
 /// The mannequin's file name without its extension (the export adds it).
 pub const MANNEQUIN: &str = "mannequin";
@@ -110,51 +114,85 @@ impl<'a> Outputs<'a> {
         Outputs { customer: Some(customer), ..self }
     }
 
-    /// The set of files (see the module documentation).
+    /// The set of files (see the module documentation). The files are made in parallel (and
+    /// the report's measurement of the body beside them), then added in a fixed order.
     pub fn files(&self) -> Result<OutputSet, serde_json::Error> {
-        let (result, scan) = (self.result, self.scan);
-        let mut set = OutputSet::new();
-        set.add(self.export.file_name(MANNEQUIN), result.mannequin_file(self.export, &scan.frame));
-        set.add(PROFILES, serde_json::to_vec_pretty(&result.profiles)?);
+        let (result, scan, export) = (self.result, self.scan, self.export);
+        let mut jobs: Vec<(String, Job<'a>)> = Vec::new();
+        let mut add = |name: &str, job: Job<'a>| jobs.push((name.to_string(), job));
+        add(
+            &export.file_name(MANNEQUIN),
+            Box::new(move || Ok(result.mannequin_file(export, &scan.frame))),
+        );
+        add(PROFILES, Box::new(move || serde_json::to_vec_pretty(&result.profiles)));
         if let Some((form, fit, setpoints)) = self.form {
-            set.add(SETPOINTS, setpoints.to_json_string());
-            set.add(FORM_FIT, form_fit_png(result, fit, form));
+            add(SETPOINTS, Box::new(move || Ok(setpoints.to_json_string().into_bytes())));
+            add(FORM_FIT, Box::new(move || Ok(form_fit_png(result, fit, form))));
         }
-        set.add(SECTIONS, sections_svg(&scan.body, result));
+        add(SECTIONS, Box::new(move || Ok(sections_svg(&scan.body, result).into_bytes())));
         match self.reposed {
             None => {
-                set.add(MEASUREMENTS, serde_json::to_vec_pretty(&result.comparison)?);
-                set.add(PREVIEW, preview_png(&[(&scan.body, "scan")], result));
+                add(MEASUREMENTS, Box::new(move || serde_json::to_vec_pretty(&result.comparison)));
+                add(PREVIEW, Box::new(move || Ok(preview_png(&[(&scan.body, "scan")], result))));
             }
             Some((input, reposed, as_scanned)) => {
-                let measurements = MeasurementsReport::new(as_scanned, &result.comparison);
-                set.add(MEASUREMENTS, serde_json::to_vec_pretty(&measurements)?);
-                let bodies = [(&input.body, "scan"), (&scan.body, "pose-symmetric")];
-                set.add(PREVIEW, preview_png(&bodies, result));
-                let (posed, _) = self.export.place(&scan.body, &scan.frame);
-                set.add(self.export.file_name(POSED), self.export.encode(&posed));
-                set.add(RIGGED, reposed.rigged_glb(input));
-                set.add(FIT, serde_json::to_vec_pretty(&reposed.fit_report())?);
+                add(
+                    MEASUREMENTS,
+                    Box::new(move || {
+                        serde_json::to_vec_pretty(&MeasurementsReport::new(
+                            as_scanned,
+                            &result.comparison,
+                        ))
+                    }),
+                );
+                add(
+                    PREVIEW,
+                    Box::new(move || {
+                        let bodies = [(&input.body, "scan"), (&scan.body, "pose-symmetric")];
+                        Ok(preview_png(&bodies, result))
+                    }),
+                );
+                add(
+                    &export.file_name(POSED),
+                    Box::new(move || Ok(export.encode(&export.place(&scan.body, &scan.frame).0))),
+                );
+                add(RIGGED, Box::new(move || Ok(reposed.rigged_glb(input))));
+                add(FIT, Box::new(move || serde_json::to_vec_pretty(&reposed.fit_report())));
             }
         }
-        let html = report::render(&self.report(&set));
+        let body = match self.reposed {
+            None => "the scan",
+            Some(_) => "the pose-symmetric scan",
+        };
+        let (files, measured) = rayon::join(
+            || {
+                let made = jobs.into_par_iter().map(|(name, job)| job().map(|bytes| (name, bytes)));
+                made.collect::<Vec<_>>()
+            },
+            || Measured::of(scan, &result.regions, body),
+        );
+        let mut set = OutputSet::new();
+        for file in files {
+            let (name, bytes) = file?;
+            set.add(name, bytes);
+        }
+        let html = report::render(&self.report(&set, measured));
         set.add(REPORT, html);
         Ok(set)
     }
 
     /// The customer report of these outputs, its pictures those of `set` (their files).
-    fn report<'s>(&self, set: &'s OutputSet) -> Report<'s>
+    fn report<'s>(&self, set: &'s OutputSet, measured: Result<Measured, String>) -> Report<'s>
     where
         'a: 's,
     {
         let figure = |file, caption| Figure::of(set, file, caption);
-        let (preview, measured) = match self.reposed {
-            None => ("The scan and the mannequin, front, side and back", "the scan"),
-            Some(_) => (
+        let preview = match self.reposed {
+            None => "The scan and the mannequin, front, side and back",
+            Some(_) => {
                 "The scan as it stood, the pose-symmetric scan and the mannequin, front, side \
-                 and back",
-                "the pose-symmetric scan",
-            ),
+                 and back"
+            }
         };
         let sections = "The chest, waist and hip seen from above, front at the bottom: the \
                         scan, its halves mirrored and the symmetric mannequin";
@@ -171,7 +209,7 @@ impl<'a> Outputs<'a> {
                 .into_iter()
                 .flatten()
                 .collect(),
-            measurements: Some(Measured::of(self.scan, measured)),
+            measurements: Some(measured),
             form,
             fit_test: None,
         }

@@ -247,9 +247,9 @@ pub fn reconstruct(
     options: &ReconstructOptions,
     mut progress: impl FnMut(usize),
 ) -> Result<Reconstruction, ReconstructError> {
-    let reposed = repose(scan, model, options, &mut progress)?;
+    let (reposed, as_scanned) = repose_and_measure(scan, model, options, &mut progress);
+    let reposed = reposed?;
     progress(REPOSE_STEPS.len());
-    let as_scanned = measure_as_scanned(scan);
     let result =
         pipeline::symmetrize(&reposed.posed, &options.mannequin, |s| progress(STEPS.len() + s))?;
     Ok(Reconstruction { reposed, as_scanned, result })
@@ -266,9 +266,9 @@ pub fn reconstruct_shape(
     form: &FormDescription,
     mut progress: impl FnMut(usize),
 ) -> Result<Reshaped, ReconstructError> {
-    let reposed = repose(scan, model, options, &mut progress)?;
+    let (reposed, as_scanned) = repose_and_measure(scan, model, options, &mut progress);
+    let reposed = reposed?;
     progress(REPOSE_STEPS.len());
-    let as_scanned = measure_as_scanned(scan);
     let shaped =
         pipeline::shape(&reposed.posed, &options.mannequin, form, |s| progress(STEPS.len() + s))?;
     // The pose-symmetric scan's frame is the input's moved by the feet's drop (and centred):
@@ -278,6 +278,22 @@ pub fn reconstruct_shape(
     let heights: Vec<f64> = shaped.rings.iter().map(|r| r.body_z_mm - dz).collect();
     let scan_rings = as_scanned.girths_at_rings(scan, form, &heights);
     Ok(Reshaped { reposed, as_scanned, shaped, scan_rings })
+}
+
+/// [`repose`] and [`measure_as_scanned`] at once: the measuring needs nothing of the fit, and
+/// fills the cores that the fit's and the rig transfer's one-thread steps leave idle.
+fn repose_and_measure(
+    scan: &Scan,
+    model: &BodyModel,
+    options: &ReconstructOptions,
+    progress: impl FnMut(usize),
+) -> (Result<Reposed, ReconstructError>, AsScanned) {
+    let mut as_scanned = None;
+    let reposed = rayon::in_place_scope(|s| {
+        s.spawn(|_| as_scanned = Some(measure_as_scanned(scan)));
+        repose(scan, model, options, progress)
+    });
+    (reposed, as_scanned.expect("the scope ran the measuring"))
 }
 
 /// How far re-posing from `fitted.theta` to `symmetric` lowers the feet (mm; negative when it

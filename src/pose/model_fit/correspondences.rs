@@ -5,9 +5,11 @@
 //! rim, and would be dragged there), each weighted robustly ([`super::robust`]). Nearest
 //! neighbours by `kiddo` k-d trees.
 
+pub mod robust_distance;
+
 use super::params::vertex_normals;
 use super::robust;
-use crate::body::mesh::{Mesh, reduce, topology};
+use crate::body::mesh::{Mesh, topology};
 use glam::{DMat3, DVec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -90,47 +92,6 @@ impl Quadratics {
     pub fn cost(&self, x: &[DVec3]) -> f64 {
         self.terms.iter().map(|(v, a, c, e)| x[*v].dot(*a * x[*v]) - 2.0 * c.dot(x[*v]) + e).sum()
     }
-}
-
-/// How far the posed model (`vertices` with `normals`) lies from the scan, robustly, both ways:
-/// the mean Geman-McClure cost ([`robust::cost`] at scale `sigma`) of each model vertex to its
-/// nearest scan point and of each sampled scan point to its nearest model vertex, a pair whose
-/// normals disagree (or whose scan point lies on a hole's boundary) counted as unmatched, at
-/// the full `sigma^2`; the two directions weigh alike. Unlike the quadratics of [`gather`],
-/// whose weights vanish for pairs far apart (a limb far from the scan costs almost nothing
-/// there), this charges every part of the model away from the scan, and every part of the scan
-/// the model does not cover: the measure that tells several starts apart
-/// ([`super::arm_starts`]).
-pub fn robust_distance(
-    cloud: &ScanCloud,
-    vertices: &[DVec3],
-    normals: &[DVec3],
-    sigma: f64,
-) -> f64 {
-    let scan = cloud.scan;
-    let unmatched = sigma * sigma;
-    let pair = |v: usize, s: usize| {
-        let agree = normals[v].dot(scan.normals[s]) >= MIN_NORMAL_COS;
-        if agree && !scan.on_hole_boundary[s] {
-            robust::cost(vertices[v].distance_squared(scan.points[s]), sigma)
-        } else {
-            unmatched
-        }
-    };
-    // Summed in a fixed order ([`reduce::sum`]): the arm starts compare these costs, and a
-    // rayon `sum` rounds differently from run to run.
-    let to_scan = reduce::sum(vertices.len(), |v| {
-        let hit = cloud.tree.nearest_one::<SquaredEuclidean>(&vertices[v].to_array());
-        pair(v, hit.item as usize)
-    });
-    let coords: Vec<[f64; 3]> = vertices.iter().map(|p| p.to_array()).collect();
-    let model_tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&coords);
-    let to_model = reduce::sum(cloud.samples.len(), |i| {
-        let s = cloud.samples[i];
-        let hit = model_tree.nearest_one::<SquaredEuclidean>(&scan.points[s].to_array());
-        pair(hit.item as usize, s)
-    });
-    0.5 * (to_scan / vertices.len().max(1) as f64 + to_model / cloud.samples.len().max(1) as f64)
 }
 
 /// One pair: model vertex, scan point, the normal of its plane, its robust weight.

@@ -6,7 +6,6 @@
 use super::correspondences::Quadratics;
 use super::params::{Params, Posed, PreparedModel};
 use super::priors::Priors;
-use glam::DVec3;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
@@ -48,7 +47,7 @@ pub fn iterate(
     lambda: f64,
 ) -> Step {
     let n = prep.layout.size();
-    let (mut h, mut g) = normal_equations(prep, data, posed);
+    let (mut h, mut g) = normal_equations(prep, data, posed, active);
     priors.add_to(prep.layout, params, posed, &mut h, &mut g);
     let parents = &prep.model.skeleton.parents;
     let index: Vec<usize> = (0..n).filter(|&i| active[i]).collect();
@@ -85,8 +84,8 @@ pub fn iterate(
 const TERMS_PER_BLOCK: usize = 1024;
 
 /// `J^T W J` and `J^T W r` of the data term (halved: the cost is `x^T A x - 2 c.x + e`, its
-/// gradient `2 (A x - c)`, its Gauss-Newton Hessian `2 J^T A J`; the priors use the same halves).
-/// Summed over fixed blocks of terms in parallel, the blocks then added in order (as
+/// gradient `2 (A x - c)`, its Gauss-Newton Hessian `2 J^T A J`; the priors use the same halves),
+/// in the rows and columns of the `active` parameters only (the others stay zero). Summed over fixed blocks of terms in parallel, the blocks then added in order (as
 /// [`crate::body::mesh::reduce`] does): a rayon `fold().reduce()` groups the additions as threads
 /// steal work, and a last-bit difference in one step grows through the fit into every output
 /// (issue 29: the same scan gave different files).
@@ -94,6 +93,7 @@ fn normal_equations(
     prep: &PreparedModel,
     data: &Quadratics,
     posed: &Posed,
+    active: &[bool],
 ) -> (DMatrix<f64>, DVector<f64>) {
     let n = prep.layout.size();
     let zeros = || (DMatrix::zeros(n, n), DVector::zeros(n));
@@ -102,16 +102,20 @@ fn normal_equations(
         .par_chunks(TERMS_PER_BLOCK)
         .map(|block| {
             let (mut h, mut g) = zeros();
-            let mut cols = Vec::new();
+            let (mut cols, mut ac) = (Vec::new(), Vec::new());
             for (v, a, c, _) in block {
                 prep.jacobian(posed, *v, &mut cols);
+                // The rows and columns of parameters the stage holds fixed are never read.
+                cols.retain(|&(i, _)| active[i]);
                 let r = *a * posed.vertices[*v] - *c;
-                let ac: Vec<DVec3> = cols.iter().map(|(_, col)| *a * *col).collect();
-                for &(i, col) in &cols {
-                    g[i] += col.dot(r);
-                    for (&(j, _), acj) in cols.iter().zip(&ac) {
-                        h[(i, j)] += col.dot(*acj);
-                    }
+                cols.iter().for_each(|&(i, col)| g[i] += col.dot(r));
+                // Each entry takes one addition per term, so the loops may run column by
+                // column (along the matrix's storage) without changing a bit.
+                ac.clear();
+                ac.extend(cols.iter().map(|(_, col)| *a * *col));
+                for (&(j, _), acj) in cols.iter().zip(&ac) {
+                    let column = &mut h.as_mut_slice()[j * n..(j + 1) * n];
+                    cols.iter().for_each(|&(i, col)| column[i] += col.dot(*acj));
                 }
             }
             (h, g)

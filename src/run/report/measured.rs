@@ -1,11 +1,12 @@
 //! The measurement table of the report: the body measured as `dressform measure` measures it
-//! ([`measure_scan`]), one row per ISO 8559-1 dimension with its definition, and for each
-//! number held back as implausible ([`crate::shape::measure::hold_back`]) "not measured" and
-//! the reason, never the number.
+//! ([`crate::shape::measure::measure_scan`]), one row per ISO 8559-1 dimension with its
+//! definition, and for each number held back as implausible
+//! ([`crate::shape::measure::hold_back`]) "not measured" and the reason, never the number.
 
 use super::definitions::{DEFINITIONS, Definition, unit};
+use crate::body::regions::BodyRegions;
 use crate::body::scan::Scan;
-use crate::shape::measure::{Unreliable, measure_scan};
+use crate::shape::measure::{Unreliable, measure_segmented_scan};
 use serde_json::Value;
 
 /// Why a value is missing when no plausibility rule held it back: its rule found no place to
@@ -88,10 +89,11 @@ impl Row {
 }
 
 impl Measured {
-    /// `scan` measured as `dressform measure` measures it; `body` says what it is. An error
-    /// says why it could not be measured (it could not be segmented).
-    pub fn of(scan: &Scan, body: &'static str) -> Result<Measured, String> {
-        let report = measure_scan(scan, &[]).map_err(|e| e.to_string())?;
+    /// `scan` measured as `dressform measure` measures it, its `regions` those
+    /// [`crate::body::segmented_body::SegmentedBody::find`] finds on it (found already, for
+    /// the mannequin); `body` says what it is. An error says why it could not be measured.
+    pub fn of(scan: &Scan, regions: &BodyRegions, body: &'static str) -> Result<Measured, String> {
+        let report = measure_segmented_scan(scan, regions, &[]).map_err(|e| e.to_string())?;
         let dimensions = serde_json::to_value(&report.dimensions).map_err(|e| e.to_string())?;
         // The held-back numbers are among the warnings too; the table gives their reasons.
         let held: Vec<String> = report.unreliable.iter().map(Unreliable::to_string).collect();

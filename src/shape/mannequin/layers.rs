@@ -7,6 +7,7 @@ use crate::body::segmented_body::SegmentedBody;
 use crate::body::slice::Contour;
 use crate::shape::symmetry::{axial, bilateral};
 use glam::DVec2;
+use rayon::prelude::*;
 
 /// How far inside the crotch the first torso and last leg layers stay (mm): exactly at the
 /// crotch the torso loop is just forming.
@@ -121,30 +122,42 @@ pub(super) fn symmetric_layers(
     centres.sort_by(f64::total_cmp);
     let axis = centres[centres.len() / 2];
 
-    let torso = torso_z
-        .iter()
+    // The layers are independent: made in parallel, the first failure (in layer order) kept.
+    let torso: Vec<Result<Layer, MannequinError>> = torso_z
+        .par_iter()
         .zip(&torso_sections)
-        .zip(side_sections.chunks_exact(2))
+        .zip(side_sections.par_chunks_exact(2))
         .map(|((&z, c), halves)| {
             let (left, right) = (&halves[0], &halves[1]);
             let girth = o.preserve.girth(c);
             let ring = axial::symmetrize_halves(left, right, axis, o.rays, o.preserve, girth)?;
             Ok(layer(Region::Torso, z, ring.centre, ring.points, c))
         })
-        .collect::<Result<Vec<_>, MannequinError>>()?;
+        .collect();
+    let torso = torso.into_iter().collect::<Result<Vec<_>, _>>()?;
 
+    let legs: Vec<Result<[Layer; 2], MannequinError>> = body
+        .sections(&leg_z)
+        .par_iter()
+        .map(|s| {
+            let labels = body.regions().label(s);
+            let find = |region| {
+                largest_with(s, &labels, region)
+                    .ok_or(MannequinError::MissingLoop { region, z: s.height })
+            };
+            let (l, r) = (find(Region::LeftLeg)?, find(Region::RightLeg)?);
+            let [lr, rr] = bilateral::symmetrize(l, r, axis, o.rays, o.preserve)?;
+            Ok([
+                layer(Region::LeftLeg, s.height, lr.centre, lr.points, l),
+                layer(Region::RightLeg, s.height, rr.centre, rr.points, r),
+            ])
+        })
+        .collect();
     let mut left_leg = Vec::with_capacity(leg_z.len());
     let mut right_leg = Vec::with_capacity(leg_z.len());
-    for s in body.sections(&leg_z) {
-        let labels = body.regions().label(&s);
-        let find = |region| {
-            largest_with(&s, &labels, region)
-                .ok_or(MannequinError::MissingLoop { region, z: s.height })
-        };
-        let (l, r) = (find(Region::LeftLeg)?, find(Region::RightLeg)?);
-        let [lr, rr] = bilateral::symmetrize(l, r, axis, o.rays, o.preserve)?;
-        left_leg.push(layer(Region::LeftLeg, s.height, lr.centre, lr.points, l));
-        right_leg.push(layer(Region::RightLeg, s.height, rr.centre, rr.points, r));
+    for [l, r] in legs.into_iter().collect::<Result<Vec<_>, _>>()? {
+        left_leg.push(l);
+        right_leg.push(r);
     }
     Ok(SymmetricLayers { axis, torso, left_leg, right_leg, is_layer })
 }

@@ -51,7 +51,7 @@ pub use plausibility::{
     LIMITS, MAX_SIDE_DIFFERENCE, Unreliable, WAIST_OVER_NARROWEST_MM, WRIST_GIRTH_MM, hold_back,
     hold_back_waist, limit,
 };
-pub use scan_report::{MeasureReport, measure_scan};
+pub use scan_report::{MeasureReport, measure_scan, measure_segmented_scan};
 
 use crate::body::mesh::Mesh;
 pub use crate::body::regions::Levels;

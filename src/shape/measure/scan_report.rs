@@ -6,7 +6,7 @@ use super::{
     BodyDimensions, Girth, Levels, Measurements, Unreliable, contact_warnings, dimensions,
     find_levels, hold_back, hold_back_waist, measure_at, narrowest_above_the_hip, stance, warnings,
 };
-use crate::body::regions::{Landmarks, RegionError};
+use crate::body::regions::{BodyRegions, Landmarks, RegionError};
 use crate::body::scan::Scan;
 use crate::body::segmented_body::SegmentedBody;
 use serde::Serialize;
@@ -38,12 +38,35 @@ pub struct MeasureReport {
 /// landmarks its file carries; any other body is segmented and its levels found, a level
 /// that fell back to the body's proportions noted among the warnings.
 pub fn measure_scan(scan: &Scan, at: &[f64]) -> Result<MeasureReport, RegionError> {
+    measure_found(scan, None, at)
+}
+
+/// [`measure_scan`] of a scan whose body was segmented already: `regions` are those
+/// [`SegmentedBody::find`] finds on it (the mannequin's pipeline found them), not looked for
+/// again.
+pub fn measure_segmented_scan(
+    scan: &Scan,
+    regions: &BodyRegions,
+    at: &[f64],
+) -> Result<MeasureReport, RegionError> {
+    measure_found(scan, Some(regions), at)
+}
+
+/// [`measure_scan`], with the body's regions when they were found already.
+fn measure_found(
+    scan: &Scan,
+    regions: Option<&BodyRegions>,
+    at: &[f64],
+) -> Result<MeasureReport, RegionError> {
     let (body, levels, fallbacks) = match scan.carried {
         Some(carried) => {
             (SegmentedBody::armless(&scan.body, carried.landmarks), carried.levels, Vec::new())
         }
         None => {
-            let body = SegmentedBody::find(&scan.body)?;
+            let body = match regions {
+                Some(regions) => SegmentedBody::with_regions(&scan.body, regions),
+                None => SegmentedBody::find(&scan.body)?,
+            };
             let found = find_levels(&body);
             (body, found.levels, found.fallbacks)
         }

@@ -8,7 +8,7 @@
 
 use crate::body::slice::Contour;
 use glam::DVec2;
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// Unit direction of ray `i` of `n` (ray 0 to the front, -Y; counter-clockwise from above).
 pub fn direction(i: usize, n: usize) -> DVec2 {
@@ -16,11 +16,53 @@ pub fn direction(i: usize, n: usize) -> DVec2 {
     DVec2::new(a.cos(), a.sin())
 }
 
-/// Distance from `centre` to the farthest crossing of `contour` along each of `n` rays.
+/// Distance from `centre` to the farthest crossing of `contour` along each of `n` rays: the
+/// same as [`cast_along`] the directions of [`direction`], found faster. An edge can only be
+/// crossed by the rays between its ends' directions, so each edge is tried against those (and
+/// one more each side, far beyond any rounding), not against every ray; an edge within
+/// [`NEAR_CENTRE_MM`] of the centre or turning more than [`MAX_TURN`] about it is tried
+/// against every ray. Each crossing is computed as [`cast_along`] computes it, and the
+/// farthest is the same whatever the order, so the radii are the same to the bit.
 pub fn cast(contour: &Contour, centre: DVec2, n: usize) -> Vec<f64> {
     let directions: Vec<DVec2> = (0..n).map(|i| direction(i, n)).collect();
-    cast_along(contour, centre, &directions)
+    let pts = &contour.points;
+    let m = pts.len();
+    let mut farthest: Vec<Option<f64>> = vec![None; n];
+    // The fractional index of the ray along `angle` (radians, counter-clockwise from +X).
+    let ray = |angle: f64| (angle - 1.5 * PI) / TAU * n as f64;
+    for k in 0..m {
+        let (a, b) = (pts[k] - centre, pts[(k + 1) % m] - centre);
+        let mut try_ray = |i: usize| {
+            if let Some(t) = crossing(directions[i], a, b) {
+                farthest[i] = Some(farthest[i].map_or(t, |f: f64| f.max(t)));
+            }
+        };
+        let turn = a.perp_dot(b).atan2(a.dot(b));
+        if a.length() < NEAR_CENTRE_MM || b.length() < NEAR_CENTRE_MM || turn.abs() > MAX_TURN {
+            (0..n).for_each(try_ray);
+            continue;
+        }
+        let from = ray(a.y.atan2(a.x));
+        let to = from + turn / TAU * n as f64;
+        let (first, last) = (from.min(to).floor() as i64 - 1, from.max(to).ceil() as i64 + 1);
+        (first..=last).for_each(|i| try_ray(i.rem_euclid(n as i64) as usize));
+    }
+    farthest
+        .into_iter()
+        .zip(&directions)
+        .map(|(f, &d)| f.unwrap_or_else(|| extent(pts, centre, d)))
+        .collect()
 }
+
+/// [`cast`] tries an edge this close to the centre (mm) against every ray: its ends'
+/// directions mean little there.
+const NEAR_CENTRE_MM: f64 = 1e-3;
+
+/// [`cast`] tries an edge turning more than this about the centre (radians) against every
+/// ray: a quarter turn, far more than a section's edge turns about its centre (at most a few
+/// degrees), far less than the half turn beyond which the ends' directions no longer bound
+/// the crossing rays.
+const MAX_TURN: f64 = FRAC_PI_2;
 
 /// Distance from `centre` to the farthest crossing of `contour` along each unit direction.
 pub fn cast_along(contour: &Contour, centre: DVec2, directions: &[DVec2]) -> Vec<f64> {
@@ -31,22 +73,33 @@ pub fn cast_along(contour: &Contour, centre: DVec2, directions: &[DVec2]) -> Vec
         .map(|&d| {
             let mut farthest: Option<f64> = None;
             for k in 0..m {
-                let (a, b) = (pts[k] - centre, pts[(k + 1) % m] - centre);
-                let e = b - a;
-                let denom = d.perp_dot(e);
-                if denom.abs() < 1e-300 {
-                    continue;
-                }
-                // centre + t d = a + s e  =>  t = a x e / (d x e), s = a x d / (d x e)
-                let t = a.perp_dot(e) / denom;
-                let s = a.perp_dot(d) / denom;
-                if t >= 0.0 && (0.0..=1.0).contains(&s) {
+                if let Some(t) = crossing(d, pts[k] - centre, pts[(k + 1) % m] - centre) {
                     farthest = Some(farthest.map_or(t, |f: f64| f.max(t)));
                 }
             }
-            farthest.unwrap_or_else(|| pts.iter().map(|p| (*p - centre).dot(d)).fold(0.0, f64::max))
+            farthest.unwrap_or_else(|| extent(pts, centre, d))
         })
         .collect()
+}
+
+/// How far along the unit direction `d` from `centre` the ray crosses the edge from `a` to
+/// `b` (both relative to `centre`), if it does.
+fn crossing(d: DVec2, a: DVec2, b: DVec2) -> Option<f64> {
+    let e = b - a;
+    let denom = d.perp_dot(e);
+    if denom.abs() < 1e-300 {
+        return None;
+    }
+    // centre + t d = a + s e  =>  t = a x e / (d x e), s = a x d / (d x e)
+    let t = a.perp_dot(e) / denom;
+    let s = a.perp_dot(d) / denom;
+    (t >= 0.0 && (0.0..=1.0).contains(&s)).then_some(t)
+}
+
+/// What a ray along `d` that misses the contour `pts` takes: the contour's extent in its
+/// direction from `centre`.
+fn extent(pts: &[DVec2], centre: DVec2, d: DVec2) -> f64 {
+    pts.iter().map(|p| (*p - centre).dot(d)).fold(0.0, f64::max)
 }
 
 /// The rays' origin for `contour`: its bounding-box centre (eq. 5), or, where that lies
@@ -119,6 +172,33 @@ mod tests {
         };
         assert_eq!(off_the_u(ray_origin(&u)), 0);
         assert!(off_the_u(u.bbox_centre()) > 0);
+    }
+
+    #[test]
+    fn cast_gives_the_radii_of_cast_along_to_the_bit() {
+        // A wavy, non-star-shaped loop (a flower with deep petals), from centres inside, on an
+        // edge, on a vertex and outside, with few and many rays.
+        let flower = Contour {
+            points: (0..997)
+                .map(|k| {
+                    let a = TAU * k as f64 / 997.0;
+                    let r = 300.0 + 180.0 * (7.0 * a).sin() + 3.0 * (91.0 * a).cos();
+                    DVec2::new(r * a.cos() + 0.3 * (5.0 * a).sin() * r, r * a.sin())
+                })
+                .collect(),
+        };
+        let on_edge = (flower.points[10] + flower.points[11]) / 2.0;
+        for centre in
+            [DVec2::ZERO, DVec2::new(40.0, -25.0), on_edge, flower.points[3], DVec2::X * 900.0]
+        {
+            for n in [4, 7, 72, 360, 1000] {
+                let directions: Vec<DVec2> = (0..n).map(|i| direction(i, n)).collect();
+                let (fast, all) =
+                    (cast(&flower, centre, n), cast_along(&flower, centre, &directions));
+                let bits = |r: &[f64]| r.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&fast), bits(&all), "centre {centre}, {n} rays");
+            }
+        }
     }
 
     #[test]
