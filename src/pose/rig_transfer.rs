@@ -26,7 +26,7 @@ pub const TRUSTED_NORMAL_COS: f64 = 0.866;
 /// one: the closest triangle touches one of them unless the model is badly stretched.
 const CANDIDATE_VERTICES: std::num::NonZeroUsize = std::num::NonZeroUsize::new(3).unwrap();
 
-/// Jacobi sweeps of the inpainting over the filled vertices: a filled region is at most a
+/// Sweeps of the inpainting over the filled vertices (Gauss-Seidel: each sweep updates in place): a filled region is at most a
 /// hole's or an armpit's width across, a few dozen scan edges.
 const FILL_SWEEPS: usize = 60;
 

@@ -137,3 +137,79 @@ fn nearest_among(
     })
     .concat()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{ScanCloud, ScanPoints};
+    use super::*;
+
+    /// `n` points spread over a sphere of `radius` (a Fibonacci spiral), each pushed out by a
+    /// little of `wobble` so that no two distances tie.
+    fn sphere(n: usize, radius: f64, wobble: f64) -> Vec<DVec3> {
+        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        (0..n)
+            .map(|i| {
+                let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+                let (r, a) = ((1.0 - z * z).sqrt(), golden * i as f64);
+                DVec3::new(r * a.cos(), r * a.sin(), z)
+                    * (radius + wobble * (i as f64 * 0.37).sin())
+            })
+            .collect()
+    }
+
+    /// The distance searched by brute force over the whole model: what [`RobustDistance`]
+    /// must give, to the bit (the same pairs, summed in the same order).
+    fn brute(cloud: &ScanCloud, sigma: f64, vertices: &[DVec3], normals: &[DVec3]) -> f64 {
+        let scan = cloud.scan;
+        let pair = |v: usize, s: usize| {
+            let agree = normals[v].dot(scan.normals[s]) >= MIN_NORMAL_COS;
+            if agree && !scan.on_hole_boundary[s] {
+                robust::cost(vertices[v].distance_squared(scan.points[s]), sigma)
+            } else {
+                sigma * sigma
+            }
+        };
+        let nearest = |p: DVec3, among: &[DVec3]| {
+            (0..among.len()).min_by(|&a, &b| {
+                p.distance_squared(among[a]).total_cmp(&p.distance_squared(among[b]))
+            })
+        };
+        let to_scan = reduce::sum(vertices.len(), |v| {
+            pair(v, nearest(vertices[v], scan.points).expect("a scan point"))
+        });
+        let to_model = reduce::sum(cloud.samples.len(), |i| {
+            let s = cloud.samples[i];
+            pair(nearest(scan.points[s], vertices).expect("a vertex"), s)
+        });
+        0.5 * (to_scan / vertices.len() as f64 + to_model / cloud.samples.len() as f64)
+    }
+
+    #[test]
+    fn searching_the_moving_part_alone_gives_the_whole_search_to_the_bit() {
+        let points = sphere(3000, 100.0, 2.0);
+        let mut on_hole_boundary = vec![false; points.len()];
+        on_hole_boundary[10..40].iter_mut().for_each(|b| *b = true);
+        let normals = points.iter().map(|p| p.normalize()).collect();
+        let scan = ScanPoints { points: &points, normals, on_hole_boundary };
+        let cloud = ScanCloud::new(&scan, 3);
+        let model = sphere(800, 104.0, 3.0);
+        let moving: Vec<bool> = model.iter().map(|p| p.x > 40.0).collect();
+        let sigma = 10.0;
+        let mut distance = RobustDistance::new(&cloud, sigma, moving.clone());
+        // The arm turned about the vertical axis, further each time: the still part stays.
+        for angle in [0.0f64, 0.1, 0.3, 0.6] {
+            let turn = glam::DQuat::from_rotation_z(angle);
+            let posed: Vec<DVec3> = (0..model.len())
+                .map(|v| if moving[v] { turn * model[v] } else { model[v] })
+                .collect();
+            let normals: Vec<DVec3> = posed.iter().map(|p| p.normalize()).collect();
+            let found = distance.of(&posed, &normals);
+            let expected = brute(&cloud, sigma, &posed, &normals);
+            assert_eq!(
+                found.to_bits(),
+                expected.to_bits(),
+                "at {angle} rad: {found} vs {expected}"
+            );
+        }
+    }
+}
