@@ -377,12 +377,22 @@ pub(super) fn track(
     if sections[seed].loops.is_empty() {
         return Err(RegionError::NoTorso { z: grid.z(seed) });
     }
-    let up = follow(&sections, seed..grid.count, 0);
-    let legs = track_legs(&sections, grid, seed)?;
-    let apart = legs.apart.map(|(i, k)| &sections[i].loops[k]);
-    let crotch =
-        refine_crotch(body, grid.z(legs.crotch_level - 1), grid.z(legs.crotch_level), apart);
-    let down = follow(&sections, (legs.crotch_level..=seed).rev(), 0);
+    // The torso up from the seed beside the legs, the crotch and the torso down to it; then
+    // each side's arm beside the other's: each is serial, level by level.
+    let (up, lower) = rayon::join(
+        || follow(&sections, seed..grid.count, 0),
+        || {
+            let legs = track_legs(&sections, grid, seed)?;
+            let apart = legs.apart.map(|(i, k)| &sections[i].loops[k]);
+            let (below, above) = (grid.z(legs.crotch_level - 1), grid.z(legs.crotch_level));
+            let (crotch, down) = rayon::join(
+                || refine_crotch(body, below, above, apart),
+                || follow(&sections, (legs.crotch_level..=seed).rev(), 0),
+            );
+            Ok((legs, crotch, down))
+        },
+    );
+    let (legs, crotch, down) = lower?;
     let mut torso: Vec<Option<usize>> = vec![None; grid.count];
     for &(i, k) in up.iter().chain(&down) {
         torso[i] = Some(k);
@@ -396,7 +406,8 @@ pub(super) fn track(
             to: grid.z(chin),
         })
     };
-    let (left, right) = (arm(1.0, "left")?, arm(-1.0, "right")?);
+    let (left, right) = rayon::join(|| arm(1.0, "left"), || arm(-1.0, "right"));
+    let (left, right) = (left?, right?);
     // The centre line: the torso's bounding-box centre just below the lower armpit.
     let lower = if left.level <= right.level { left } else { right };
     let centre_x = sections[lower.level].loops[lower.torso].bbox_centre().x;
@@ -417,23 +428,33 @@ pub(super) fn track(
             }
         }
     };
-    let (left_pit, right_pit) = (armpit_point(left, 1.0), armpit_point(right, -1.0));
-    let neck = neck_level(&sections, grid, &up, left_pit.0.z.max(right_pit.0.z));
-    let ankle = ankle_level(&sections, grid, &legs);
-
+    let (left_pit, right_pit) =
+        rayon::join(|| armpit_point(left, 1.0), || armpit_point(right, -1.0));
     // Armholes: through each armpit and its shoulder point, facing sideways.
     // The triangles reaching the lower armpit or higher: all either shoulder point looks at.
     let lower_pit = left_pit.0.z.min(right_pit.0.z);
-    let upper: Vec<u32> = (0..body.triangles.len() as u32)
-        .into_par_iter()
-        .filter(|&t| body.corners(t as usize).iter().any(|p| p.z >= lower_pit))
-        .collect();
+    let ((neck, ankle), upper) = rayon::join(
+        || {
+            rayon::join(
+                || neck_level(&sections, grid, &up, left_pit.0.z.max(right_pit.0.z)),
+                || ankle_level(&sections, grid, &legs),
+            )
+        },
+        || -> Vec<u32> {
+            (0..body.triangles.len() as u32)
+                .into_par_iter()
+                .filter(|&t| body.corners(t as usize).iter().any(|p| p.z >= lower_pit))
+                .collect()
+        },
+    );
     let armhole = |(pit, contact): (DVec3, Option<Contact>), sign: f64, name: &'static str| {
         let shoulder = armhole::shoulder_point(body, &upper, sign, centre_x, pit, neck)
             .ok_or(RegionError::NoShoulder { side: name, armpit: pit.z })?;
         let plate = Armhole::through(pit, shoulder, DVec3::NEG_Y, sign);
         Ok(contact.map_or(plate, |c| plate.with_contact(c)))
     };
+    let (left_armhole, right_armhole) =
+        rayon::join(|| armhole(left_pit, 1.0, "left"), || armhole(right_pit, -1.0, "right"));
     let landmarks = Landmarks {
         height: floor + height,
         crotch,
@@ -442,8 +463,8 @@ pub(super) fn track(
         right_armpit: right_pit.0.z,
         neck,
         centre_x,
-        left_armhole: armhole(left_pit, 1.0, "left")?,
-        right_armhole: armhole(right_pit, -1.0, "right")?,
+        left_armhole: left_armhole?,
+        right_armhole: right_armhole?,
     };
     let levels = label_levels(sections, grid, &torso, &legs, &landmarks);
     Ok(BodyRegions { landmarks, labelling: super::Labelling::Tracked { step, levels } })
@@ -460,7 +481,7 @@ fn label_levels(
 ) -> Vec<LabelledSection> {
     let (neck, centre_x) = (landmarks.neck, landmarks.centre_x);
     sections
-        .into_iter()
+        .into_par_iter()
         .enumerate()
         .map(|(i, section)| {
             let z = grid.z(i);
