@@ -12,13 +12,14 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
-/// One triangle's piece of one plane: from `start` on edge `from` to `end` on edge `to`.
+/// One triangle's piece of one plane: from `start` on edge `from` to the point on edge `to`.
+/// That end point is the next segment's start (computed once, by the triangle it starts);
+/// only an open chain's last end is computed again ([`crossing_of`]).
 #[derive(Debug, Clone, Copy)]
 struct Segment {
     from: u64,
     to: u64,
     start: DVec2,
-    end: DVec2,
 }
 
 /// Key of the undirected edge between vertices `a` and `b`.
@@ -34,6 +35,11 @@ fn crossing(mesh: &Mesh, a: u32, b: u32, h: f64) -> DVec2 {
     let t = (h - p.z) / (q.z - p.z);
     let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
     (p + (q - p) * t).truncate()
+}
+
+/// Where the edge with key `key` ([`edge_key`]) meets height `h`.
+fn crossing_of(mesh: &Mesh, key: u64, h: f64) -> DVec2 {
+    crossing(mesh, (key >> 32) as u32, key as u32, h)
 }
 
 /// The segment triangle `tri` leaves on the plane at `h` (it must cross it).
@@ -52,7 +58,6 @@ fn segment(mesh: &Mesh, tri: [u32; 3], h: f64) -> Segment {
         from: edge_key(down.0, down.1),
         to: edge_key(up.0, up.1),
         start: crossing(mesh, down.0, down.1, h),
-        end: crossing(mesh, up.0, up.1, h),
     }
 }
 
@@ -125,7 +130,7 @@ pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
                 .iter()
                 .map(|&t| segment(mesh, mesh.triangles[t as usize], h))
                 .collect();
-            chain(&segments, h)
+            chain(&segments, h, |key| crossing_of(mesh, key, h))
         })
         .collect();
     let mut out: Vec<Section> = heights
@@ -203,8 +208,9 @@ fn successors(segments: &[Segment]) -> Vec<u32> {
     segments.iter().map(|s| starting.get(&s.to).copied().unwrap_or(NONE)).collect()
 }
 
-/// Chains one plane's segments into loops, closing open chains by pairing their loose ends.
-fn chain(segments: &[Segment], height: f64) -> Section {
+/// Chains one plane's segments into loops, closing open chains by pairing their loose ends;
+/// `end(to)` is where a segment ends on its edge `to`.
+fn chain(segments: &[Segment], height: f64, end: impl Fn(u64) -> DVec2) -> Section {
     let next = successors(segments);
     let mut is_target = vec![false; segments.len()];
     for &j in &next {
@@ -223,7 +229,7 @@ fn chain(segments: &[Segment], height: f64) -> Section {
                 j if j as usize == first => return (points, true),
                 j if j != NONE && !used[j as usize] => at = j as usize,
                 _ => {
-                    points.push(segments[at].end); // an open chain keeps its last point
+                    points.push(end(segments[at].to)); // an open chain keeps its last point
                     return (points, false);
                 }
             }
