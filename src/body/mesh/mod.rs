@@ -140,10 +140,8 @@ impl Mesh {
     }
 
     /// Maps every position by `f` in place.
-    pub fn transform(&mut self, f: impl Fn(DVec3) -> DVec3) {
-        for p in &mut self.positions {
-            *p = f(*p);
-        }
+    pub fn transform(&mut self, f: impl Fn(DVec3) -> DVec3 + Sync) {
+        self.positions.par_iter_mut().for_each(|p| *p = f(*p));
     }
 
     /// Keeps only the triangles for which `keep` is true, then drops unused vertices.
