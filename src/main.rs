@@ -1,11 +1,19 @@
 //! The `dressform` command line: a thin layer over the library (see `dressform --help`).
 
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+mod allocator;
 mod cli;
 
 use clap::Parser;
 use std::process::ExitCode;
 
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+#[global_allocator]
+static ALLOCATOR: allocator::Allocator = allocator::Allocator;
+
 fn main() -> ExitCode {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    allocator::configure();
     let args = cli::Args::parse();
     match cli::run(args) {
         Ok(()) if cli::output_failed() => ExitCode::FAILURE,
