@@ -96,100 +96,122 @@ impl Armhole {
     }
 }
 
-/// The highest surface point at each lateral offset `u` (mm outward from `centre_x` on
-/// `side`) over `us`, among the triangles of `body` listed in `upper` that reach above
-/// `z_min`: the upper edge of the front silhouette, as (height, y) per offset (`None` where
-/// no surface is there).
-fn silhouette_top(
-    body: &Mesh,
-    upper: &[u32],
-    centre_x: f64,
-    side: f64,
-    us: &[f64],
-    z_min: f64,
-) -> Vec<Option<(f64, f64)>> {
-    let (u0, step) = (us[0], PROFILE_STEP_MM);
-    let lateral = |p: DVec3| side * (p.x - centre_x);
-    let higher = |slot: &Option<(f64, f64)>, z: f64| slot.is_none_or(|(top, _)| z > top);
-    // In parallel over blocks of triangles, merged in order: the first highest point wins,
-    // as in one pass.
-    crate::body::mesh::reduce::fold(
-        upper.len(),
-        || vec![None; us.len()],
-        |mut top: Vec<Option<(f64, f64)>>, i| {
-            let c = body.corners(upper[i] as usize);
-            if c.iter().all(|p| p.z < z_min) {
-                return top;
-            }
-            let u = c.map(lateral);
-            let (lo, hi) = (u[0].min(u[1]).min(u[2]), u[0].max(u[1]).max(u[2]));
-            let first = ((lo - u0) / step).ceil().max(0.0) as usize;
-            let last = (((hi - u0) / step).floor()).min(us.len() as f64 - 1.0);
-            if last < first as f64 {
-                return top;
-            }
-            for (b, slot) in top.iter_mut().enumerate().take(last as usize + 1).skip(first) {
-                let ub = us[b];
-                for k in 0..3 {
-                    let (a, e) = ((c[k], u[k]), (c[(k + 1) % 3], u[(k + 1) % 3]));
-                    if (a.1 - ub) * (e.1 - ub) > 0.0 || a.1 == e.1 {
-                        continue;
-                    }
-                    let p = a.0.lerp(e.0, (ub - a.1) / (e.1 - a.1));
-                    if higher(slot, p.z) {
-                        *slot = Some((p.z, p.y));
-                    }
-                }
-            }
-            top
-        },
-        |mut top, later| {
-            for (slot, l) in top.iter_mut().zip(later) {
-                if l.is_some_and(|(z, _)| higher(slot, z)) {
-                    *slot = l;
-                }
-            }
-            top
-        },
-    )
-}
-
-/// The shoulder point on `side` (+1 left, -1 right) of `body`, given its armpit, the torso's
-/// centre line `centre_x` and the neck's height (the silhouette above it is the head's);
-/// `upper` lists the triangles reaching the armpit's height or higher (or more).
-pub(super) fn shoulder_point(
-    body: &Mesh,
-    upper: &[u32],
+/// The shoulder point's search on one side: the lateral offsets sampled (mm outward from the
+/// torso's centre line, from [`SEARCH_INWARD_MM`] inside the armpit to [`SEARCH_OUTWARD_MM`]
+/// outside it, every [`PROFILE_STEP_MM`], on the side's half only).
+pub(super) struct ShoulderSearch {
     side: f64,
     centre_x: f64,
     armpit: DVec3,
-    neck: f64,
-) -> Option<DVec3> {
-    let u_armpit = side * (armpit.x - centre_x);
-    let count = ((SEARCH_INWARD_MM + SEARCH_OUTWARD_MM) / PROFILE_STEP_MM) as usize + 1;
-    let us: Vec<f64> = (0..count)
-        .map(|k| u_armpit - SEARCH_INWARD_MM + PROFILE_STEP_MM * k as f64)
-        .filter(|&u| u > 0.0)
-        .collect();
-    if us.is_empty() {
-        return None;
+    offsets: Vec<f64>,
+}
+
+impl ShoulderSearch {
+    /// The search on `side` (+1 left, -1 right) of the centre line `centre_x`, beside `armpit`.
+    pub(super) fn new(side: f64, centre_x: f64, armpit: DVec3) -> ShoulderSearch {
+        let u_armpit = side * (armpit.x - centre_x);
+        let count = ((SEARCH_INWARD_MM + SEARCH_OUTWARD_MM) / PROFILE_STEP_MM) as usize + 1;
+        let offsets = (0..count)
+            .map(|k| u_armpit - SEARCH_INWARD_MM + PROFILE_STEP_MM * k as f64)
+            .filter(|&u| u > 0.0)
+            .collect();
+        ShoulderSearch { side, centre_x, armpit, offsets }
     }
-    let top = silhouette_top(body, upper, centre_x, side, &us, armpit.z);
-    let point = |k: usize| top[k].map(|(z, y)| DVec3::new(centre_x + side * us[k], y, z));
-    // Shoulder samples: on the surface, above the armpit, below the neck.
-    let on_shoulder = |k: usize| top[k].is_some_and(|(z, _)| z > armpit.z && z < neck);
-    let start = (0..us.len()).find(|&k| on_shoulder(k))?;
-    let edge: Vec<usize> = (start..us.len()).take_while(|&k| on_shoulder(k)).collect();
-    let (&first, &last) = (edge.first()?, edge.last()?);
-    // The corner: the sample farthest from the chord between the edge's ends (the "knee").
-    let at = |k: usize| top[k].map(|(z, _)| glam::DVec2::new(us[k], z));
-    let (a, b) = (at(first)?, at(last)?);
-    let chord = (b - a).normalize_or(glam::DVec2::X);
-    let corner = edge
-        .iter()
-        .filter_map(|&k| at(k).map(|p| (k, chord.perp_dot(p - a).abs())))
-        .max_by(|x, y| x.1.total_cmp(&y.1))?;
-    point(corner.0)
+
+    /// Lateral offset of `p`.
+    fn lateral(&self, p: DVec3) -> f64 {
+        self.side * (p.x - self.centre_x)
+    }
+
+    /// Whether a triangle (its corners) may bear on the search: it reaches the armpit's height
+    /// and spans the sampled offsets (with a step's margin). The triangles that do not are
+    /// the ones [`Self::shoulder_point`] would pass over, so listing only these changes nothing.
+    pub(super) fn may_touch(&self, c: &[DVec3; 3]) -> bool {
+        let (Some(&first), Some(&last)) = (self.offsets.first(), self.offsets.last()) else {
+            return false;
+        };
+        let u = c.map(|p| self.lateral(p));
+        c.iter().any(|p| p.z >= self.armpit.z)
+            && u.iter().any(|&u| u >= first - PROFILE_STEP_MM)
+            && u.iter().any(|&u| u <= last + PROFILE_STEP_MM)
+    }
+
+    /// The highest surface point at each sampled offset among the triangles of `body` listed
+    /// in `near` that reach the armpit's height: the upper edge of the front silhouette, as
+    /// (height, y) per offset (`None` where no surface is there).
+    fn silhouette_top(&self, body: &Mesh, near: &[u32]) -> Vec<Option<(f64, f64)>> {
+        let (us, z_min) = (&self.offsets, self.armpit.z);
+        let (u0, step) = (us[0], PROFILE_STEP_MM);
+        let higher = |slot: &Option<(f64, f64)>, z: f64| slot.is_none_or(|(top, _)| z > top);
+        // In parallel over blocks of triangles, merged in order: the first highest point wins,
+        // as in one pass.
+        crate::body::mesh::reduce::fold(
+            near.len(),
+            || vec![None; us.len()],
+            |mut top: Vec<Option<(f64, f64)>>, i| {
+                let c = body.corners(near[i] as usize);
+                if c.iter().all(|p| p.z < z_min) {
+                    return top;
+                }
+                let u = c.map(|p| self.lateral(p));
+                let (lo, hi) = (u[0].min(u[1]).min(u[2]), u[0].max(u[1]).max(u[2]));
+                let first = ((lo - u0) / step).ceil().max(0.0) as usize;
+                let last = (((hi - u0) / step).floor()).min(us.len() as f64 - 1.0);
+                if last < first as f64 {
+                    return top;
+                }
+                for (b, slot) in top.iter_mut().enumerate().take(last as usize + 1).skip(first) {
+                    let ub = us[b];
+                    for k in 0..3 {
+                        let (a, e) = ((c[k], u[k]), (c[(k + 1) % 3], u[(k + 1) % 3]));
+                        if (a.1 - ub) * (e.1 - ub) > 0.0 || a.1 == e.1 {
+                            continue;
+                        }
+                        let p = a.0.lerp(e.0, (ub - a.1) / (e.1 - a.1));
+                        if higher(slot, p.z) {
+                            *slot = Some((p.z, p.y));
+                        }
+                    }
+                }
+                top
+            },
+            |mut top, later| {
+                for (slot, l) in top.iter_mut().zip(later) {
+                    if l.is_some_and(|(z, _)| higher(slot, z)) {
+                        *slot = l;
+                    }
+                }
+                top
+            },
+        )
+    }
+
+    /// The shoulder point of `body`, given the neck's height (the silhouette above it is the
+    /// head's); `near` lists (in the body's order) at least the triangles that
+    /// [`Self::may_touch`] the search.
+    pub(super) fn shoulder_point(&self, body: &Mesh, near: &[u32], neck: f64) -> Option<DVec3> {
+        let (us, armpit) = (&self.offsets, self.armpit);
+        if us.is_empty() {
+            return None;
+        }
+        let top = self.silhouette_top(body, near);
+        let point =
+            |k: usize| top[k].map(|(z, y)| DVec3::new(self.centre_x + self.side * us[k], y, z));
+        // Shoulder samples: on the surface, above the armpit, below the neck.
+        let on_shoulder = |k: usize| top[k].is_some_and(|(z, _)| z > armpit.z && z < neck);
+        let start = (0..us.len()).find(|&k| on_shoulder(k))?;
+        let edge: Vec<usize> = (start..us.len()).take_while(|&k| on_shoulder(k)).collect();
+        let (&first, &last) = (edge.first()?, edge.last()?);
+        // The corner: the sample farthest from the chord between the edge's ends (the "knee").
+        let at = |k: usize| top[k].map(|(z, _)| glam::DVec2::new(us[k], z));
+        let (a, b) = (at(first)?, at(last)?);
+        let chord = (b - a).normalize_or(glam::DVec2::X);
+        let corner = edge
+            .iter()
+            .filter_map(|&k| at(k).map(|p| (k, chord.perp_dot(p - a).abs())))
+            .max_by(|x, y| x.1.total_cmp(&y.1))?;
+        point(corner.0)
+    }
 }
 
 /// The closest pair of points of two loops: (on `a`, on `b`).
@@ -242,5 +264,30 @@ mod tests {
         let reach = clipped.points.iter().map(|p| p.x).fold(f64::MIN, f64::max);
         assert!((reach - 170.0).abs() < 1e-9, "{reach}");
         assert_eq!(left.clip(&square, 1100.0), square, "below the armpit nothing is cut");
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(128))]
+
+        /// The silhouette from the triangles that may touch the search is the silhouette from
+        /// all of them: triangles strewn across both sides, above and below the armpit, at
+        /// and beyond the window's ends.
+        #[test]
+        fn only_the_triangles_that_may_touch_bear_on_the_silhouette(
+            corners in proptest::collection::vec(
+                (-400.0f64..400.0, -100.0f64..100.0, 1000.0f64..1400.0), 3..120),
+            side in proptest::prop_oneof![proptest::strategy::Just(1.0), proptest::strategy::Just(-1.0)],
+            pit in (60.0f64..250.0, 1100.0f64..1300.0),
+        ) {
+            let body = Mesh {
+                positions: corners.iter().map(|&(x, y, z)| DVec3::new(x, y, z)).collect(),
+                triangles: (0..corners.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
+            };
+            let search = ShoulderSearch::new(side, 10.0, DVec3::new(10.0 + side * pit.0, 0.0, pit.1));
+            let all: Vec<u32> = (0..body.triangles.len() as u32).collect();
+            let near: Vec<u32> =
+                all.iter().copied().filter(|&t| search.may_touch(&body.corners(t as usize))).collect();
+            proptest::prop_assert_eq!(search.silhouette_top(&body, &near), search.silhouette_top(&body, &all));
+        }
     }
 }

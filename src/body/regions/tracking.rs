@@ -430,31 +430,29 @@ pub(super) fn track(
     };
     let (left_pit, right_pit) =
         rayon::join(|| armpit_point(left, 1.0), || armpit_point(right, -1.0));
-    // Armholes: through each armpit and its shoulder point, facing sideways.
-    // The triangles reaching the lower armpit or higher: all either shoulder point looks at.
-    let lower_pit = left_pit.0.z.min(right_pit.0.z);
-    let ((neck, ankle), upper) = rayon::join(
+    // Armholes: through each armpit and its shoulder point, facing sideways; each shoulder
+    // point looked for among the triangles near its side's search.
+    let searches = [(left_pit.0, 1.0), (right_pit.0, -1.0)]
+        .map(|(pit, sign)| armhole::ShoulderSearch::new(sign, centre_x, pit));
+    let ((neck, ankle), near) = rayon::join(
         || {
             rayon::join(
                 || neck_level(&sections, grid, &up, left_pit.0.z.max(right_pit.0.z)),
                 || ankle_level(&sections, grid, &legs),
             )
         },
-        || -> Vec<u32> {
-            (0..body.triangles.len() as u32)
-                .into_par_iter()
-                .filter(|&t| body.corners(t as usize).iter().any(|p| p.z >= lower_pit))
-                .collect()
-        },
+        || near_shoulders(body, &searches),
     );
-    let armhole = |(pit, contact): (DVec3, Option<Contact>), sign: f64, name: &'static str| {
-        let shoulder = armhole::shoulder_point(body, &upper, sign, centre_x, pit, neck)
+    let armhole = |k: usize, (pit, contact): (DVec3, Option<Contact>), name: &'static str| {
+        let sign = [1.0, -1.0][k];
+        let shoulder = searches[k]
+            .shoulder_point(body, &near[k], neck)
             .ok_or(RegionError::NoShoulder { side: name, armpit: pit.z })?;
         let plate = Armhole::through(pit, shoulder, DVec3::NEG_Y, sign);
         Ok(contact.map_or(plate, |c| plate.with_contact(c)))
     };
     let (left_armhole, right_armhole) =
-        rayon::join(|| armhole(left_pit, 1.0, "left"), || armhole(right_pit, -1.0, "right"));
+        rayon::join(|| armhole(0, left_pit, "left"), || armhole(1, right_pit, "right"));
     let landmarks = Landmarks {
         height: floor + height,
         crotch,
@@ -468,6 +466,29 @@ pub(super) fn track(
     };
     let levels = label_levels(sections, grid, &torso, &legs, &landmarks);
     Ok(BodyRegions { landmarks, labelling: super::Labelling::Tracked { step, levels } })
+}
+
+/// The triangles of `body` that [`armhole::ShoulderSearch::may_touch`] each of the two
+/// searches, in the body's order, from one pass over the body.
+fn near_shoulders(body: &Mesh, searches: &[armhole::ShoulderSearch; 2]) -> [Vec<u32>; 2] {
+    crate::body::mesh::reduce::fold(
+        body.triangles.len(),
+        || [Vec::new(), Vec::new()],
+        |mut near: [Vec<u32>; 2], t| {
+            let c = body.corners(t);
+            for (list, search) in near.iter_mut().zip(searches) {
+                if search.may_touch(&c) {
+                    list.push(t as u32);
+                }
+            }
+            near
+        },
+        |[mut left, mut right], [later_left, later_right]| {
+            left.extend(later_left);
+            right.extend(later_right);
+            [left, right]
+        },
+    )
 }
 
 /// Every tracked level's loops labelled: the tracked torso (at and above the neck, head) and
