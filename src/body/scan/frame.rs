@@ -439,14 +439,28 @@ fn accumulate<const N: usize>(
     blocks.into_iter().fold([Moments::default(); N], merge)
 }
 
+/// The trunk's band, by fraction of the height from the floor: hips to shoulders.
+const TRUNK_BAND: (f64, f64) = (0.45, 0.75);
+/// The feet's band: up to this fraction of the height.
+const FEET_BAND_TOP: f64 = 0.04;
+/// The shins' band, by fraction of the height.
+const SHIN_BAND: (f64, f64) = (0.10, 0.25);
+
 /// The surface's bands along an up direction, by fraction of the height: trunk (hips to
 /// shoulders), feet, shins; horizontal coordinates on the two other axes.
 struct Bands {
-    u: DVec3,
+    /// The up direction's axis, and +1 or -1 along it.
+    axis: usize,
+    sign: f64,
     floor: f64,
     height: f64,
     e1: DVec3,
     e2: DVec3,
+    /// The bands' limits along the up direction (`floor + fraction * height`), so that a
+    /// triangle's band takes comparisons only, no division, in the pass over every triangle.
+    trunk: (f64, f64),
+    feet_top: f64,
+    shins: (f64, f64),
 }
 
 impl Bands {
@@ -454,24 +468,36 @@ impl Bands {
         let u = up.vector();
         let (floor, top) =
             (bounds.min.dot(u).min(bounds.max.dot(u)), bounds.min.dot(u).max(bounds.max.dot(u)));
+        let height = top - floor;
+        let at = |fraction: f64| floor + fraction * height;
         let e1 = Direction { axis: (up.axis + 1) % 3, negative: false }.vector();
         let e2 = Direction { axis: (up.axis + 2) % 3, negative: false }.vector();
-        Bands { u, floor, height: top - floor, e1, e2 }
+        Bands {
+            axis: up.axis,
+            sign: if up.negative { -1.0 } else { 1.0 },
+            floor,
+            height,
+            e1,
+            e2,
+            trunk: (at(TRUNK_BAND.0), at(TRUNK_BAND.1)),
+            feet_top: at(FEET_BAND_TOP),
+            shins: (at(SHIN_BAND.0), at(SHIN_BAND.1)),
+        }
     }
 
-    /// Horizontal coordinates of `p`.
+    /// Horizontal coordinates of `p` (its coordinates on the axes `e1` and `e2`).
     fn flat(&self, p: DVec3) -> DVec2 {
-        DVec2::new(p.dot(self.e1), p.dot(self.e2))
+        DVec2::new(p[(self.axis + 1) % 3], p[(self.axis + 2) % 3])
     }
 
     /// Adds a triangle (centroid `p`, area `a`) to the moments of its band: `m` holds trunk,
     /// feet, shins.
     fn add(&self, m: &mut [Moments], p: DVec3, a: f64) {
-        let f = (p.dot(self.u) - self.floor) / self.height;
-        let band = match f {
-            _ if (0.45..=0.75).contains(&f) => 0,
-            _ if f <= 0.04 => 1,
-            _ if (0.10..=0.25).contains(&f) => 2,
+        let s = self.sign * p[self.axis];
+        let band = match s {
+            _ if (self.trunk.0..=self.trunk.1).contains(&s) => 0,
+            _ if s <= self.feet_top => 1,
+            _ if (self.shins.0..=self.shins.1).contains(&s) => 2,
             _ => return,
         };
         m[band].add(p, a, self.flat(p));
