@@ -118,6 +118,11 @@ impl ShoulderSearch {
         ShoulderSearch { side, centre_x, armpit, offsets }
     }
 
+    /// The side searched: +1 the subject's left, -1 the right.
+    pub(super) fn side(&self) -> f64 {
+        self.side
+    }
+
     /// Lateral offset of `p`.
     fn lateral(&self, p: DVec3) -> f64 {
         self.side * (p.x - self.centre_x)

@@ -444,11 +444,10 @@ pub(super) fn track(
         || near_shoulders(body, &searches),
     );
     let armhole = |k: usize, (pit, contact): (DVec3, Option<Contact>), name: &'static str| {
-        let sign = [1.0, -1.0][k];
         let shoulder = searches[k]
             .shoulder_point(body, &near[k], neck)
             .ok_or(RegionError::NoShoulder { side: name, armpit: pit.z })?;
-        let plate = Armhole::through(pit, shoulder, DVec3::NEG_Y, sign);
+        let plate = Armhole::through(pit, shoulder, DVec3::NEG_Y, searches[k].side());
         Ok(contact.map_or(plate, |c| plate.with_contact(c)))
     };
     let (left_armhole, right_armhole) =
