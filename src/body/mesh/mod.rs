@@ -157,8 +157,12 @@ impl Mesh {
     /// The part of the mesh made of the triangles for which `keep` is true, with only the
     /// vertices they use (in order of first use).
     pub fn part(&self, keep: impl Fn([u32; 3]) -> bool + Sync) -> Mesh {
-        let mut triangles: Vec<[u32; 3]> =
-            self.triangles.par_iter().copied().filter(|&tri| keep(tri)).collect();
+        self.part_of(self.triangles.par_iter().copied().filter(|&tri| keep(tri)).collect())
+    }
+
+    /// The part of the mesh made of `triangles` (some of its own), with only the vertices they
+    /// use (in order of first use).
+    pub fn part_of(&self, mut triangles: Vec<[u32; 3]>) -> Mesh {
         let mut index: FxHashMap<u32, u32> = FxHashMap::default();
         let mut positions = Vec::new();
         for v in triangles.iter_mut().flatten() {

@@ -43,20 +43,46 @@ fn follow(
     out
 }
 
-/// The part of `body` between the heights `below` and `above`: all a bisection between two
-/// tracking levels needs to cut.
-fn between(body: &Mesh, below: f64, above: f64) -> Mesh {
-    body.part(|tri| {
-        let z = tri.map(|v| body.positions[v as usize].z);
-        z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
-    })
+/// Whether triangle `tri` of `body` reaches from `below` to `above` or across them: the
+/// triangles a bisection between two tracking levels needs to cut.
+fn spans(body: &Mesh, tri: [u32; 3], below: f64, above: f64) -> bool {
+    let z = tri.map(|v| body.positions[v as usize].z);
+    z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
+}
+
+/// The triangles of a body reaching a height or higher (a corner at or above it), in order:
+/// from the lower arm's join up, all that the armpits' bisections and the shoulders' searches
+/// look at, found in one pass over the body instead of one per search.
+struct Reaching<'a> {
+    body: &'a Mesh,
+    triangles: Vec<u32>,
+}
+
+impl<'a> Reaching<'a> {
+    /// The triangles of `body` reaching `from`.
+    fn new(body: &'a Mesh, from: f64) -> Reaching<'a> {
+        let reaches = |t: &u32| {
+            body.triangles[*t as usize].iter().any(|&v| body.positions[v as usize].z >= from)
+        };
+        let triangles = (0..body.triangles.len() as u32).into_par_iter().filter(reaches).collect();
+        Reaching { body, triangles }
+    }
+
+    /// The part of the body between the heights `below` and `above` (`below` no lower than the
+    /// height these triangles reach, or the part misses triangles under it).
+    fn between(&self, below: f64, above: f64) -> Mesh {
+        let body = self.body;
+        let tri = |&t: &u32| body.triangles[t as usize];
+        let kept = self.triangles.par_iter().map(tri).filter(|&t| spans(body, t, below, above));
+        body.part_of(kept.collect())
+    }
 }
 
 /// The crotch between `below` (the legs apart, their loops around `legs`) and `above` (one
 /// loop around both), by bisection to [`BISECTION_MM`], cutting only the part of the body
 /// between the two heights.
 fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, legs: [&Contour; 2]) -> f64 {
-    let near = between(body, below, above);
+    let near = body.part(|tri| spans(body, tri, below, above));
     while above - below > BISECTION_MM {
         let mid = 0.5 * (below + above);
         let s = &sections(&near, &[mid])[0];
@@ -75,14 +101,15 @@ const SHIN_LEVEL: f64 = 0.15;
 /// and `above` (joined), by bisection to [`BISECTION_MM`]: the middle of the narrowest gap
 /// between the arm and the torso just below where they join. The arm grows upward into the
 /// join, so a level holds it apart as long as the torso's loop there does not overlap `arm`.
+/// Cuts only the triangles `upper` (reaching `below`).
 fn refine_armpit(
-    body: &Mesh,
+    upper: &Reaching,
     mut below: f64,
     mut above: f64,
     arm: &Contour,
     torso: &Contour,
 ) -> DVec3 {
-    let near = between(body, below, above);
+    let near = upper.between(below, above);
     let torso_c = torso.centroid();
     let mut apart = (arm.clone(), torso.clone());
     while above - below > BISECTION_MM {
@@ -107,8 +134,9 @@ fn refine_armpit(
 /// `join.level`, joined from `joined` mm), the first level where the neck between them has
 /// opened, refined by bisection to [`BISECTION_MM`]; `None` when the neck is open on the first
 /// joined level (an arm that leaves the torso at an angle: its armpit is where the loops join).
+/// Cuts only the triangles `upper` (reaching the join's level).
 fn top_of_contact(
-    body: &Mesh,
+    upper: &Reaching,
     levels: &[Section],
     grid: Grid,
     up: &[(usize, usize)],
@@ -128,7 +156,7 @@ fn top_of_contact(
     let (closed_level, closed_loop) = *above[first_open - 1];
     let mut closed: Neck = neck_of(&levels[closed_level].loops[closed_loop])?;
     let (mut below, mut top) = (grid.z(closed_level), grid.z(above[first_open].0));
-    let near = between(body, below, top);
+    let near = upper.between(below, top);
     let centre = torso.centroid();
     while top - below > BISECTION_MM {
         let mid = 0.5 * (below + top);
@@ -168,15 +196,16 @@ fn reach(c: &Contour, sign: f64, centre: f64) -> f64 {
 /// The armpit of an arm that grows straight out of the torso's loop between `below` (the
 /// torso's loop `torso` there, not yet joined) and `above`, by bisection to [`BISECTION_MM`]:
 /// the torso's outermost point on side `sign` at the highest level where its reach has not
-/// yet jumped by [`ARM_JUMP_MM`] — the crease under the arm.
+/// yet jumped by [`ARM_JUMP_MM`] — the crease under the arm. Cuts only the triangles `upper`
+/// (reaching `below`).
 fn refine_outgrowth(
-    body: &Mesh,
+    upper: &Reaching,
     mut below: f64,
     mut above: f64,
     torso: &Contour,
     sign: f64,
 ) -> DVec3 {
-    let near = between(body, below, above);
+    let near = upper.between(below, above);
     let (torso_c, centre) = (torso.centroid(), torso.bbox_centre().x);
     let limit = reach(torso, sign, centre) + ARM_JUMP_MM;
     let mut apart = torso.clone();
@@ -408,6 +437,7 @@ pub(super) fn track(
     };
     let (left, right) = rayon::join(|| arm(1.0, "left"), || arm(-1.0, "right"));
     let (left, right) = (left?, right?);
+    let upper = Reaching::new(body, grid.z(left.level.min(right.level)));
     // The centre line: the torso's bounding-box centre just below the lower armpit.
     let lower = if left.level <= right.level { left } else { right };
     let centre_x = sections[lower.level].loops[lower.torso].bbox_centre().x;
@@ -417,14 +447,14 @@ pub(super) fn track(
         match join.how {
             Join::Loop(k) => {
                 let arm = &sections[i].loops[k];
-                let pit = refine_armpit(body, grid.z(i), grid.z(i + 1), arm, torso_loop);
-                match top_of_contact(body, &sections, grid, &up, &join, arm, pit.z) {
+                let pit = refine_armpit(&upper, grid.z(i), grid.z(i + 1), arm, torso_loop);
+                match top_of_contact(&upper, &sections, grid, &up, &join, arm, pit.z) {
                     Some((top, contact)) => (top, Some(contact)),
                     None => (pit, None),
                 }
             }
             Join::Outgrowth => {
-                (refine_outgrowth(body, grid.z(i), grid.z(i + 1), torso_loop, sign), None)
+                (refine_outgrowth(&upper, grid.z(i), grid.z(i + 1), torso_loop, sign), None)
             }
         }
     };
@@ -441,7 +471,7 @@ pub(super) fn track(
                 || ankle_level(&sections, grid, &legs),
             )
         },
-        || near_shoulders(body, &searches),
+        || near_shoulders(&upper, &searches),
     );
     let armhole = |k: usize, (pit, contact): (DVec3, Option<Contact>), name: &'static str| {
         let shoulder = searches[k]
@@ -467,17 +497,19 @@ pub(super) fn track(
     Ok(BodyRegions { landmarks, labelling: super::Labelling::Tracked { step, levels } })
 }
 
-/// The triangles of `body` that [`armhole::ShoulderSearch::may_touch`] each of the two
-/// searches, in the body's order, from one pass over the body.
-fn near_shoulders(body: &Mesh, searches: &[armhole::ShoulderSearch; 2]) -> [Vec<u32>; 2] {
+/// The triangles of the body that [`armhole::ShoulderSearch::may_touch`] each of the two
+/// searches, in the body's order, from one pass over the triangles `upper` (reaching below
+/// both armpits: all that may touch).
+fn near_shoulders(upper: &Reaching, searches: &[armhole::ShoulderSearch; 2]) -> [Vec<u32>; 2] {
+    let (body, among) = (upper.body, &upper.triangles);
     crate::body::mesh::reduce::fold(
-        body.triangles.len(),
+        among.len(),
         || [Vec::new(), Vec::new()],
-        |mut near: [Vec<u32>; 2], t| {
-            let c = body.corners(t);
+        |mut near: [Vec<u32>; 2], i| {
+            let c = body.corners(among[i] as usize);
             for (list, search) in near.iter_mut().zip(searches) {
                 if search.may_touch(&c) {
-                    list.push(t as u32);
+                    list.push(among[i]);
                 }
             }
             near
