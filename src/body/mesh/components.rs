@@ -20,7 +20,11 @@ pub struct Component {
 /// The connected components of a mesh.
 #[derive(Debug, Clone)]
 pub struct Components {
-    /// The pieces, largest area first.
+    /// How many pieces the mesh has (a vertex no triangle uses is none).
+    pub count: usize,
+    /// The pieces, largest area first, when there are several; empty for a mesh in one piece
+    /// (the common case of a scan: there is nothing to choose between, so its area and box,
+    /// a pass over every triangle, are not measured).
     pub parts: Vec<Component>,
     /// For each vertex, the index of its piece in `parts`; [`NO_PIECE`] for a vertex that no
     /// triangle uses.
@@ -37,9 +41,9 @@ impl Components {
     }
 }
 
-/// The connected components of `mesh`: a parallel union-find over vertices, then parallel
-/// passes for the pieces' triangle counts and areas (over triangles) and boxes (over
-/// vertices).
+/// The connected components of `mesh`: a parallel union-find over vertices; where there are
+/// several pieces, parallel passes for their triangle counts and areas (over triangles) and
+/// boxes (over vertices).
 pub fn components(mesh: &Mesh) -> Components {
     let sets = DisjointSets::new(mesh.positions.len());
     mesh.triangles.par_chunks(1 << 12).for_each(|block| {
@@ -48,10 +52,16 @@ pub fn components(mesh: &Mesh) -> Components {
             sets.union(a, c);
         }
     });
-    // A piece's root is its smallest vertex: numbering the roots in order numbers the pieces
-    // in order of first appearance.
     let mut of_vertex: Vec<u32> =
         (0..mesh.positions.len() as u32).into_par_iter().map(|v| sets.find(v)).collect();
+    // One piece: every triangle's root is the first's.
+    let first = mesh.triangles.first().map(|t| of_vertex[t[0] as usize]);
+    if mesh.triangles.par_iter().all(|t| Some(of_vertex[t[0] as usize]) == first) {
+        of_vertex.par_iter_mut().for_each(|r| *r = if Some(*r) == first { 0 } else { NO_PIECE });
+        return Components { count: usize::from(first.is_some()), parts: Vec::new(), of_vertex };
+    }
+    // A piece's root is its smallest vertex: numbering the roots in order numbers the pieces
+    // in order of first appearance.
     let roots: Vec<u32> = (0..mesh.positions.len() as u32)
         .into_par_iter()
         .filter(|&v| of_vertex[v as usize] == v)
@@ -88,8 +98,8 @@ pub fn components(mesh: &Mesh) -> Components {
         }
         of_vertex.par_iter_mut().for_each(|id| *id = rank[*id as usize]);
     }
-    let parts = order.into_iter().map(|id| parts[id].clone()).collect();
-    Components { parts, of_vertex }
+    let parts: Vec<Component> = order.into_iter().map(|id| parts[id].clone()).collect();
+    Components { count: parts.len(), parts, of_vertex }
 }
 
 /// Sums something over the items `0..items` of each of `pieces` pieces, in parallel and in a
@@ -213,6 +223,24 @@ mod tests {
         assert!(!found.is_one_piece());
     }
 
+    #[test]
+    fn one_piece_is_counted_not_measured() {
+        let mut mesh = Mesh::default();
+        add_tetrahedron(&mut mesh, DVec3::ZERO, 1.0);
+        let found = components(&mesh);
+        assert_eq!((found.count, found.parts.len()), (1, 0));
+        assert!(found.is_one_piece());
+        mesh.positions.push(DVec3::splat(7.0)); // used by no triangle
+        let found = components(&mesh);
+        assert_eq!((found.count, found.parts.len()), (1, 0));
+        assert_eq!(found.of_vertex, [0, 0, 0, 0, NO_PIECE]);
+        assert!(!found.is_one_piece());
+        mesh.triangles.clear();
+        let found = components(&mesh);
+        assert_eq!((found.count, found.parts.len()), (0, 0));
+        assert!(found.of_vertex.iter().all(|&p| p == NO_PIECE));
+    }
+
     /// The pieces of `triangles` over `n` vertices by a plain sequential search: for each
     /// vertex, the smallest vertex of its piece (`None` if unused).
     fn reference(n: usize, triangles: &[[u32; 3]]) -> Vec<Option<usize>> {
@@ -267,9 +295,13 @@ mod tests {
                     prop_assert_eq!(piece, found.of_vertex[a]);
                 }
             }
-            prop_assert_eq!(piece_of_root.len(), found.parts.len());
-            let triangles: usize = found.parts.iter().map(|p| p.triangles).sum();
-            prop_assert_eq!(triangles, mesh.triangles.len());
+            prop_assert_eq!(piece_of_root.len(), found.count);
+            // Several pieces are measured; one is the whole mesh.
+            prop_assert_eq!(found.parts.len(), if found.count > 1 { found.count } else { 0 });
+            if found.count > 1 {
+                let triangles: usize = found.parts.iter().map(|p| p.triangles).sum();
+                prop_assert_eq!(triangles, mesh.triangles.len());
+            }
         }
     }
 }

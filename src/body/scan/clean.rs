@@ -113,8 +113,10 @@ pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
 
     let found = components(&mesh);
     let total: f64 = found.parts.iter().map(|c| c.area).sum();
-    let dropped_components = found.parts[1..]
+    let dropped_components = found
+        .parts
         .iter()
+        .skip(1)
         .map(|c| DroppedComponent {
             triangles: c.triangles,
             area_fraction: c.area / total,
@@ -129,7 +131,7 @@ pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
     let report = CleaningReport {
         welded_vertices,
         degenerate_triangles,
-        components: found.parts.len(),
+        components: found.count,
         dropped_components,
     };
     Ok((mesh, report))
