@@ -92,44 +92,14 @@ pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
     // vertex is looked up once, and most triangles are dropped after comparing three counts.
     let below: Vec<u32> =
         mesh.positions.par_iter().map(|p| planes.at_or_below(p.z) as u32).collect();
-    let crossed: Vec<(u32, u32, u32)> = mesh
-        .triangles
-        .par_iter()
-        .enumerate()
-        .filter_map(|(t, tri)| {
-            let c = tri.map(|v| below[v as usize]);
-            let (first, end) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
-            (first < end).then_some((first, end, t as u32))
-        })
-        .collect();
-    // The triangles of each plane, grouped by a counting sort.
     let n = planes.sorted.len();
-    let mut offsets = vec![0usize; n + 1];
-    for &(first, end, _) in &crossed {
-        for k in first..end {
-            offsets[k as usize + 1] += 1;
-        }
-    }
-    for k in 0..n {
-        offsets[k + 1] += offsets[k];
-    }
-    let mut fill = offsets.clone();
-    let mut crossing = vec![0u32; offsets[n]];
-    for &(first, end, t) in &crossed {
-        for k in first as usize..end as usize {
-            crossing[fill[k]] = t;
-            fill[k] += 1;
-        }
-    }
-
+    let crossings = Crossings::new(mesh, &below, n);
     let by_plane: Vec<Section> = (0..n)
         .into_par_iter()
         .map(|k| {
             let h = planes.sorted[k];
-            let segments: Vec<Segment> = crossing[offsets[k]..offsets[k + 1]]
-                .iter()
-                .map(|&t| segment(mesh, mesh.triangles[t as usize], h))
-                .collect();
+            let mut segments: Vec<Segment> = Vec::with_capacity(crossings.count(k));
+            segments.extend(crossings.of(k).map(|t| segment(mesh, mesh.triangles[t as usize], h)));
             chain(&segments, h, |key| crossing_of(mesh, key, h))
         })
         .collect();
@@ -141,6 +111,78 @@ pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
         out[i] = section;
     }
     out
+}
+
+/// Triangles per block of [`Crossings`]: enough blocks for every core on a scan, few enough
+/// that a plane's list is a handful of slices.
+const CROSSINGS_BLOCK: usize = 1 << 15;
+
+/// The triangles crossing each plane, in increasing order: a counting sort by plane within
+/// each block of [`CROSSINGS_BLOCK`] triangles, the blocks sorted in parallel (no serial pass
+/// over the crossings, and no list of them all before they are sorted); a plane's triangles
+/// are its slice of each block, blocks in order.
+struct Crossings {
+    blocks: Vec<CrossingBlock>,
+}
+
+/// One block's triangles by plane: those of plane `k` are `triangles[offsets[k]..offsets[k + 1]]`.
+struct CrossingBlock {
+    offsets: Vec<u32>,
+    triangles: Vec<u32>,
+}
+
+impl Crossings {
+    /// The crossings of `planes` planes by the triangles of `mesh`, whose vertices have
+    /// `below[v]` planes at or below them: a triangle crosses the planes from its lowest
+    /// vertex's count up to (not including) its highest's.
+    fn new(mesh: &Mesh, below: &[u32], planes: usize) -> Crossings {
+        let blocks = mesh
+            .triangles
+            .par_chunks(CROSSINGS_BLOCK)
+            .enumerate()
+            .map(|(b, block)| {
+                let crossed: Vec<(u32, u32, u32)> = (block.iter().enumerate())
+                    .filter_map(|(i, tri)| {
+                        let c = tri.map(|v| below[v as usize]);
+                        let (first, end) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+                        (first < end).then_some((first, end, (b * CROSSINGS_BLOCK + i) as u32))
+                    })
+                    .collect();
+                let mut offsets = vec![0u32; planes + 1];
+                for &(first, end, _) in &crossed {
+                    for k in first..end {
+                        offsets[k as usize + 1] += 1;
+                    }
+                }
+                for k in 0..planes {
+                    offsets[k + 1] += offsets[k];
+                }
+                let mut fill = offsets.clone();
+                let mut triangles = vec![0u32; offsets[planes] as usize];
+                for &(first, end, t) in &crossed {
+                    for k in first as usize..end as usize {
+                        triangles[fill[k] as usize] = t;
+                        fill[k] += 1;
+                    }
+                }
+                CrossingBlock { offsets, triangles }
+            })
+            .collect();
+        Crossings { blocks }
+    }
+
+    /// How many triangles cross plane `k`.
+    fn count(&self, k: usize) -> usize {
+        self.blocks.iter().map(|b| (b.offsets[k + 1] - b.offsets[k]) as usize).sum()
+    }
+
+    /// The triangles crossing plane `k`, in increasing order.
+    fn of(&self, k: usize) -> impl Iterator<Item = u32> + '_ {
+        self.blocks
+            .iter()
+            .flat_map(move |b| b.triangles[b.offsets[k] as usize..b.offsets[k + 1] as usize].iter())
+            .copied()
+    }
 }
 
 /// Sorted, finite plane heights, bucketed so that counting the planes at or below a height
