@@ -54,17 +54,28 @@ pub fn run(args: &SliceArgs) -> Result<(), Failure> {
     }
     let options =
         ScanOptions { frame: args.frame.options(), smooth: args.smooth, max_triangles: None };
-    // Segmentation and the sections run while the scan's topology is checked.
-    let (prepared, (regions, sections)) = scan::prepare_then(&args.mesh, &options, |scan| {
-        match &scan.carried {
-            // A mannequin dressform made: labelled by the landmarks its file carries.
-            Some(carried) => {
-                (Ok(BodyRegions::armless(carried.landmarks)), sections(&scan.body, &args.heights))
+    // The scan's topology is checked beside the segmentation's tracking (or the sections).
+    let (prepared, (regions, sections)) =
+        scan::prepare_then(&args.mesh, &options, |scan, check| {
+            match &scan.carried {
+                // A mannequin dressform made: labelled by the landmarks its file carries.
+                Some(carried) => {
+                    let (cut, checked) =
+                        rayon::join(|| sections(&scan.body, &args.heights), || check.run());
+                    ((Ok(BodyRegions::armless(carried.landmarks)), cut), checked)
+                }
+                None => {
+                    let (regions, cut, checked) = BodyRegions::find_and_cut_beside(
+                        &scan.body,
+                        TRACKING_STEP_MM,
+                        &args.heights,
+                        || check.run(),
+                    );
+                    ((regions, cut), checked)
+                }
             }
-            None => BodyRegions::find_and_cut(&scan.body, TRACKING_STEP_MM, &args.heights),
-        }
-    })
-    .map_err(Failure::bad_input)?;
+        })
+        .map_err(Failure::bad_input)?;
     let file = prepared.scan.source.display().to_string();
     print_warnings(&file, &prepared.warnings, None);
     let regions = regions.map_err(|e| warn(&file, &format!("loops are not labelled: {e}"))).ok();

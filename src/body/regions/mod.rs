@@ -227,15 +227,30 @@ impl BodyRegions {
         step: f64,
         heights: &[f64],
     ) -> (Result<BodyRegions, RegionError>, Vec<Section>) {
+        let (regions, cut, ()) = Self::find_and_cut_beside(body, step, heights, || ());
+        (regions, cut)
+    }
+
+    /// [`Self::find_and_cut`], running `beside` alongside the tracking: the sweep keeps every
+    /// core busy, while the tracking's level-by-level stretches leave one idle (a caller's own
+    /// work on the body, such as its topology check, fills it).
+    pub fn find_and_cut_beside<T: Send>(
+        body: &Mesh,
+        step: f64,
+        heights: &[f64],
+        beside: impl FnOnce() -> T + Send,
+    ) -> (Result<BodyRegions, RegionError>, Vec<Section>, T) {
         let Some(bounds) = body.bounds() else {
-            return (Err(RegionError::NoTorso { z: 0.0 }), sections(body, heights));
+            let (cut, t) = rayon::join(|| sections(body, heights), beside);
+            return (Err(RegionError::NoTorso { z: 0.0 }), cut, t);
         };
         let (floor, height) = (bounds.min.z, bounds.size().z);
         let n = ((height / step).floor() as usize).max(1);
         let levels: Vec<f64> = (0..n).map(|i| floor + step * (i as f64 + 0.5)).collect();
         let mut cut = sections(body, &[&levels[..], heights].concat());
         let requested = cut.split_off(n);
-        (tracking::track(body, step, floor, height, cut), requested)
+        let (regions, t) = rayon::join(|| tracking::track(body, step, floor, height, cut), beside);
+        (regions, requested, t)
     }
 
     /// The torso's loop in `section` (cut from the same body; `None` where there is none): the

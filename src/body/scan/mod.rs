@@ -20,7 +20,7 @@ use carried::CarriedBody;
 use clean::{CleanError, CleaningReport};
 use format::{Format, MeshFile, ReadError};
 use frame::{CanonicalFrame, FrameError, FrameOptions};
-pub use prepare::{PreparedScan, ScanOptions, prepare, prepare_then};
+pub use prepare::{PreparedScan, ScanOptions, TopologyCheck, prepare, prepare_then};
 use std::path::{Path, PathBuf};
 
 /// A body scan ready for the pipeline.

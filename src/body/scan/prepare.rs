@@ -5,7 +5,7 @@
 use super::frame::FrameOptions;
 use super::{Scan, ScanError, load};
 use crate::body::mesh::decimate::decimate;
-use crate::body::mesh::topology;
+use crate::body::mesh::{Mesh, Topology, topology};
 use std::path::Path;
 
 /// How a command reads and prepares its scan.
@@ -39,15 +39,15 @@ pub struct PreparedScan {
 /// Reads the scan at `path` in the frame `options` give, gathers its warnings and smooths
 /// it (see [`PreparedScan::new`]).
 pub fn prepare(path: &Path, options: &ScanOptions) -> Result<PreparedScan, ScanError> {
-    Ok(prepare_then(path, options, |_| ())?.0)
+    Ok(prepare_then(path, options, |_, check| ((), check.run()))?.0)
 }
 
-/// [`prepare`], then `work` on the prepared scan while its topology is checked beside it (see
+/// [`prepare`], then `work` on the prepared scan, which runs its topology check (see
 /// [`PreparedScan::reduced_then`]).
 pub fn prepare_then<R: Send>(
     path: &Path,
     options: &ScanOptions,
-    work: impl FnOnce(&Scan) -> R + Send,
+    work: impl FnOnce(&Scan, TopologyCheck) -> (R, Topology) + Send,
 ) -> Result<(PreparedScan, R), ScanError> {
     let scan = load(path, &options.frame)?;
     Ok(PreparedScan::reduced_then(scan, options.smooth, options.max_triangles, work))
@@ -64,19 +64,20 @@ impl PreparedScan {
     /// [`Self::new`], the scan decimated to at most `max_triangles` between its warnings (which
     /// describe the scan as read) and the smoothing; a note says so.
     pub fn reduced(scan: Scan, passes: usize, max_triangles: Option<usize>) -> PreparedScan {
-        Self::reduced_then(scan, passes, max_triangles, |_| ()).0
+        Self::reduced_then(scan, passes, max_triangles, |_, check| ((), check.run())).0
     }
 
     /// [`Self::reduced`], then `work` on the prepared scan. The topology check (holes,
     /// manifoldness, orientation: only a warning, and a pass over every vertex's fan) runs
     /// beside the next step that reads the same triangles: the decimation where the scan is
-    /// decimated (the scan as read is then dropped before `work`), `work` otherwise (smoothing
+    /// decimated (the scan as read is then dropped before `work`), otherwise `work`, which is
+    /// handed the check to run beside whichever of its steps leaves cores idle (smoothing
     /// moves vertices, never triangles, so the smoothed scan's topology is the scan's as read).
     pub fn reduced_then<R: Send>(
         mut scan: Scan,
         passes: usize,
         max_triangles: Option<usize>,
-        work: impl FnOnce(&Scan) -> R + Send,
+        work: impl FnOnce(&Scan, TopologyCheck) -> (R, Topology) + Send,
     ) -> (PreparedScan, R) {
         let (checked, decimated) = match max_triangles {
             Some(max) if scan.body.triangles.len() > max => {
@@ -98,17 +99,35 @@ impl PreparedScan {
         if smoothed {
             scan.body.taubin_smooth(passes);
         }
-        let (checked, out) = match checked {
-            Some(t) => (t, work(&scan)),
-            // On a thread of its own: `work` keeps rayon's threads, and the check fills the
-            // cores its serial stretches leave idle.
-            None => rayon::join(|| topology(&scan.body), || work(&scan)),
+        let check = match checked {
+            Some(t) => TopologyCheck::Done(t),
+            None => TopologyCheck::Pending(&scan.body),
         };
+        let (out, checked) = work(&scan, check);
         let mut warnings = scan.cleaning.warnings();
         warnings.extend(checked.warnings());
         warnings.extend(scan.frame.units_warning());
         warnings.extend(note);
         (PreparedScan { scan, warnings, smoothed }, out)
+    }
+}
+
+/// The topology check of a prepared scan: done already (beside the decimation), or to run on
+/// the body, which [`PreparedScan::reduced_then`] hands its work to run where it fits.
+pub enum TopologyCheck<'a> {
+    /// The check's result.
+    Done(Topology),
+    /// The body still to check.
+    Pending(&'a Mesh),
+}
+
+impl TopologyCheck<'_> {
+    /// The check's result, running it if it is still to run.
+    pub fn run(self) -> Topology {
+        match self {
+            TopologyCheck::Done(t) => t,
+            TopologyCheck::Pending(body) => topology(body),
+        }
     }
 }
 
