@@ -43,7 +43,7 @@ fn census(mesh: &Mesh) -> Census {
     let used = used.iter().filter(|&&u| u).count();
     let euler = used as i64 - topology.edges as i64 + mesh.triangles.len() as i64;
     Census {
-        components: components(mesh).parts.len(),
+        components: components(mesh).count,
         unused_vertices: mesh.positions.len() - used,
         euler,
         topology,
