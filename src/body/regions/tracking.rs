@@ -437,10 +437,10 @@ pub(super) fn track(
     };
     let (left, right) = rayon::join(|| arm(1.0, "left"), || arm(-1.0, "right"));
     let (left, right) = (left?, right?);
-    let upper = Reaching::new(body, grid.z(left.level.min(right.level)));
     // The centre line: the torso's bounding-box centre just below the lower armpit.
     let lower = if left.level <= right.level { left } else { right };
     let centre_x = sections[lower.level].loops[lower.torso].bbox_centre().x;
+    let upper = Reaching::new(body, grid.z(lower.level));
     // Each armpit, and where its arm rests on the torso below it if it does.
     let armpit_point = |join: ArmJoin, sign: f64| {
         let (i, torso_loop) = (join.level, &sections[join.level].loops[join.torso]);
