@@ -54,7 +54,13 @@ pub fn components(mesh: &Mesh) -> Components {
     });
     let mut of_vertex: Vec<u32> =
         (0..mesh.positions.len() as u32).into_par_iter().map(|v| sets.find(v)).collect();
-    // One piece: every triangle's root is the first's.
+    // One piece, every vertex in it: one root, vertex 0 (a root is its piece's smallest
+    // vertex), so every vertex's piece is already 0.
+    let root = |&(v, &r): &(usize, &u32)| r == v as u32;
+    if !mesh.triangles.is_empty() && of_vertex.par_iter().enumerate().filter(root).count() == 1 {
+        return Components { count: 1, parts: Vec::new(), of_vertex };
+    }
+    // One piece besides unused vertices: every triangle's root is the first's.
     let first = mesh.triangles.first().map(|t| of_vertex[t[0] as usize]);
     if mesh.triangles.par_iter().all(|t| Some(of_vertex[t[0] as usize]) == first) {
         of_vertex.par_iter_mut().for_each(|r| *r = if Some(*r) == first { 0 } else { NO_PIECE });

@@ -11,7 +11,8 @@
 //! Holes, non-manifold edges and vertices are a diagnosis, not a repair: see
 //! [`crate::body::mesh::topology`] and [`Topology::warnings`](crate::body::mesh::topology::Topology::warnings).
 
-use crate::body::mesh::{Aabb, Mesh, components};
+use super::frame::{Survey, SurveyBlock, Surveyor};
+use crate::body::mesh::{Aabb, Mesh, components, reduce};
 use crate::messages::number;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -88,7 +89,23 @@ impl CleaningReport {
 }
 
 /// Validates `mesh` and reduces it to the body: see the module documentation.
-pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
+pub fn clean(mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
+    cleaned(mesh, false).map(|(body, report, _)| (body, report))
+}
+
+/// [`clean`], taking the canonical frame's [`Survey`] of the body in the same pass as the
+/// search for flat triangles, which measures each triangle's area anyway (one pass over the
+/// triangles' corners instead of two). The pass sees the welded mesh, so the survey is the
+/// body's only when the cleaning drops no triangle (the usual scan); `None` otherwise.
+pub fn clean_surveyed(mesh: Mesh) -> Result<(Mesh, CleaningReport, Option<Survey>), CleanError> {
+    cleaned(mesh, true)
+}
+
+/// [`clean`], with the survey when `survey` is asked for (see [`clean_surveyed`]).
+fn cleaned(
+    mut mesh: Mesh,
+    survey: bool,
+) -> Result<(Mesh, CleaningReport, Option<Survey>), CleanError> {
     if mesh.positions.par_iter().any(|p| !p.is_finite()) {
         let vertex = mesh.positions.iter().position(|p| !p.is_finite()).unwrap_or(0);
         let p = mesh.positions[vertex];
@@ -96,16 +113,34 @@ pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
     }
     let welded_vertices = mesh.weld_identical();
 
-    let degenerate = |t: usize| {
-        let [a, b, c] = mesh.triangles[t];
-        a == b || b == c || a == c || is_flat(mesh.corners(t))
-    };
-    let dropped: Vec<usize> =
-        (0..mesh.triangles.len()).into_par_iter().filter(|&t| degenerate(t)).collect();
+    let surveyor = survey.then(|| Surveyor::new(&mesh));
+    // Per block of triangles, in order: the degenerate ones, and the block's survey.
+    let blocks = reduce::blocks(mesh.triangles.len(), |range| {
+        let mut dropped = Vec::new();
+        let mut block = SurveyBlock::default();
+        for t in range {
+            let corners = mesh.corners(t);
+            let [a, b, c] = corners;
+            // Twice the area, and the centroid, as the frame's survey computes them.
+            let twice_area = (b - a).cross(c - a).length();
+            let [i, j, k] = mesh.triangles[t];
+            if i == j || j == k || i == k || is_flat(corners, twice_area) {
+                dropped.push(t);
+            }
+            if let Some(surveyor) = &surveyor {
+                surveyor.add(&mut block, (a + b + c) / 3.0, 0.5 * twice_area);
+            }
+        }
+        (dropped, block)
+    });
+    let (dropped, survey): (Vec<Vec<usize>>, Vec<SurveyBlock>) = blocks.into_iter().unzip();
+    let dropped = dropped.concat();
     let degenerate_triangles = dropped.len();
+    let mut survey = surveyor.map(|surveyor| surveyor.finish(survey));
     if degenerate_triangles > 0 {
         let mut drop = dropped.into_iter().peekable();
         mesh.retain_triangles(|t| drop.next_if_eq(&t).is_none());
+        survey = None;
     }
     if mesh.triangles.is_empty() {
         return Err(CleanError::AllDegenerate);
@@ -127,6 +162,7 @@ pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
         let body: Vec<bool> =
             mesh.triangles.par_iter().map(|t| found.of_vertex[t[0] as usize] == 0).collect();
         mesh.retain_triangles(|t| body[t]);
+        survey = None;
     }
     let report = CleaningReport {
         welded_vertices,
@@ -134,15 +170,15 @@ pub fn clean(mut mesh: Mesh) -> Result<(Mesh, CleaningReport), CleanError> {
         components: found.count,
         dropped_components,
     };
-    Ok((mesh, report))
+    Ok((mesh, report, survey))
 }
 
-/// Whether a triangle is flat: its area is within rounding of zero for its size (twice the
-/// area at most 1e-12 of its longest edge squared).
-fn is_flat([a, b, c]: [DVec3; 3]) -> bool {
+/// Whether a triangle (its corners, and twice its area) is flat: its area is within rounding
+/// of zero for its size (twice the area at most 1e-12 of its longest edge squared).
+fn is_flat([a, b, c]: [DVec3; 3], twice_area: f64) -> bool {
     let longest =
         (b - a).length_squared().max((c - b).length_squared()).max((a - c).length_squared());
-    (b - a).cross(c - a).length() <= 1e-12 * longest
+    twice_area <= 1e-12 * longest
 }
 
 #[cfg(test)]
@@ -181,8 +217,9 @@ mod tests {
         assert_eq!(body.triangles.len(), 4);
         assert_eq!(body.positions.len(), 4);
         // A tiny but well-shaped triangle is not flat.
-        assert!(!is_flat([DVec3::ZERO, DVec3::X * 1e-9, DVec3::Y * 1e-9]));
-        assert!(is_flat([DVec3::ZERO, DVec3::X, DVec3::X * 2.0]));
+        let flat = |[a, b, c]: [DVec3; 3]| is_flat([a, b, c], (b - a).cross(c - a).length());
+        assert!(!flat([DVec3::ZERO, DVec3::X * 1e-9, DVec3::Y * 1e-9]));
+        assert!(flat([DVec3::ZERO, DVec3::X, DVec3::X * 2.0]));
     }
 
     #[test]

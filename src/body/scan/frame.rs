@@ -397,12 +397,15 @@ struct Moments {
 }
 
 impl Moments {
-    fn add(&mut self, p: DVec3, a: f64, flat: DVec2) {
-        self.weight += a;
-        self.sum += p * a;
-        self.xx += a * flat.x * flat.x;
-        self.xy += a * flat.x * flat.y;
-        self.yy += a * flat.y * flat.y;
+    /// A triangle's own moments (centroid `p`, area `a`, horizontal coordinates `flat`).
+    fn of(p: DVec3, a: f64, flat: DVec2) -> Moments {
+        Moments {
+            weight: a,
+            sum: p * a,
+            xx: a * flat.x * flat.x,
+            xy: a * flat.x * flat.y,
+            yy: a * flat.y * flat.y,
+        }
     }
 
     fn merge(mut self, o: Moments) -> Moments {
@@ -419,24 +422,96 @@ impl Moments {
     }
 }
 
-/// Sums `add(moments, centroid, area)` over the triangles of `mesh`, in parallel and in a
-/// fixed order (the same bits on every run; see [`crate::body::mesh::reduce`]).
-fn accumulate<const N: usize>(
-    mesh: &Mesh,
-    add: impl Fn(&mut [Moments; N], DVec3, f64) + Sync,
-) -> [Moments; N] {
+/// Sums `add(sums, centroid, area)` over the triangles of `mesh` block by block (in
+/// parallel), in block order: with [`merged`], the same bits on every run (see
+/// [`crate::body::mesh::reduce`]).
+fn block_sums<T: Default + Send>(mesh: &Mesh, add: impl Fn(&mut T, DVec3, f64) + Sync) -> Vec<T> {
     // Each block adds into one accumulator in place (a fold that passes it by value copies
     // the moments for every triangle).
-    let blocks = crate::body::mesh::reduce::blocks(mesh.triangles.len(), |range| {
-        let mut m = [Moments::default(); N];
+    crate::body::mesh::reduce::blocks(mesh.triangles.len(), |range| {
+        let mut m = T::default();
         for t in range {
             let [a, b, c] = mesh.triangles[t].map(|v| mesh.positions[v as usize]);
             add(&mut m, (a + b + c) / 3.0, 0.5 * (b - a).cross(c - a).length());
         }
         m
-    });
+    })
+}
+
+/// The blocks' moments of [`block_sums`] (or of a pass like it), merged in block order.
+fn merged<const N: usize>(blocks: Vec<[Moments; N]>) -> [Moments; N] {
     let merge = |x: [Moments; N], y: [Moments; N]| std::array::from_fn(|k| x[k].merge(y[k]));
     blocks.into_iter().fold([Moments::default(); N], merge)
+}
+
+/// What detecting the frame needs of a body's surface, gathered in one pass over its
+/// triangles: its bounding box, the area-weighted centroid, and the moments of the trunk,
+/// feet and shins bands along its longest axis either way up (which way is up is only known
+/// from the centroid). See [`Survey::of`], or [`Surveyor`] to gather it in a pass over the
+/// triangles that another step makes anyway (the cleaning's: see
+/// [`super::clean::clean_surveyed`]).
+#[derive(Debug, Clone)]
+pub struct Survey {
+    bounds: Aabb,
+    /// Every triangle, then the longest axis's bands pointing up, then pointing down.
+    moments: [Moments; 7],
+}
+
+impl Survey {
+    /// The survey of `mesh`: a pass over its vertices for the box, one over its triangles.
+    pub fn of(mesh: &Mesh) -> Survey {
+        let surveyor = Surveyor::new(mesh);
+        let blocks = block_sums(mesh, |m: &mut SurveyBlock, p, a| surveyor.add(m, p, a));
+        surveyor.finish(blocks)
+    }
+}
+
+/// Gathers a [`Survey`] of a mesh block by block: [`Self::add`] each triangle (centroid and
+/// area, as [`block_sums`] computes them) of each block of [`crate::body::mesh::reduce::BLOCK`]
+/// triangles in order, then [`Self::finish`] with the blocks in order; the same bits as
+/// [`Survey::of`].
+pub struct Surveyor {
+    bounds: Aabb,
+    up: Bands,
+    down: Bands,
+}
+
+/// One block's share of a [`Survey`] ([`Surveyor`]): the moments of every triangle, then of
+/// the bands pointing up, then pointing down.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SurveyBlock([Moments; 7]);
+
+impl Surveyor {
+    /// A surveyor of `mesh`: its bounding box and the bands along its longest axis.
+    pub fn new(mesh: &Mesh) -> Surveyor {
+        let bounds = mesh.bounds().unwrap_or(Aabb { min: DVec3::ZERO, max: DVec3::ZERO });
+        let axis = bounds.size().max_position();
+        let along = |negative: bool| Bands::new(Direction { axis, negative }, &bounds);
+        Surveyor { bounds, up: along(false), down: along(true) }
+    }
+
+    /// Adds a triangle (centroid `p`, area `a`) to `block`: to every triangle's moments, and
+    /// to its band either way up (its own moments computed once for both).
+    pub fn add(&self, block: &mut SurveyBlock, p: DVec3, a: f64) {
+        let along = p[self.up.axis];
+        let (up, down) = (self.up.band(along), self.down.band(along));
+        let own = Moments::of(p, a, self.up.flat(p));
+        let m = &mut block.0;
+        // Of every triangle's moments only the centroid is used.
+        m[0].weight += own.weight;
+        m[0].sum += own.sum;
+        if let Some(k) = up {
+            m[1 + k] = m[1 + k].merge(own);
+        }
+        if let Some(k) = down {
+            m[4 + k] = m[4 + k].merge(own);
+        }
+    }
+
+    /// The survey from the blocks' shares, in block order.
+    pub fn finish(self, blocks: Vec<SurveyBlock>) -> Survey {
+        Survey { bounds: self.bounds, moments: merged(blocks.into_iter().map(|b| b.0).collect()) }
+    }
 }
 
 /// The trunk's band, by fraction of the height from the floor: hips to shoulders.
@@ -490,17 +565,24 @@ impl Bands {
         DVec2::new(p[(self.axis + 1) % 3], p[(self.axis + 2) % 3])
     }
 
+    /// The band of a point whose coordinate along the up direction's axis is `along`: 0 for
+    /// the trunk, 1 the feet, 2 the shins; `None` outside them.
+    fn band(&self, along: f64) -> Option<usize> {
+        let s = self.sign * along;
+        match s {
+            _ if (self.trunk.0..=self.trunk.1).contains(&s) => Some(0),
+            _ if s <= self.feet_top => Some(1),
+            _ if (self.shins.0..=self.shins.1).contains(&s) => Some(2),
+            _ => None,
+        }
+    }
+
     /// Adds a triangle (centroid `p`, area `a`) to the moments of its band: `m` holds trunk,
     /// feet, shins.
     fn add(&self, m: &mut [Moments], p: DVec3, a: f64) {
-        let s = self.sign * p[self.axis];
-        let band = match s {
-            _ if (self.trunk.0..=self.trunk.1).contains(&s) => 0,
-            _ if s <= self.feet_top => 1,
-            _ if (self.shins.0..=self.shins.1).contains(&s) => 2,
-            _ => return,
-        };
-        m[band].add(p, a, self.flat(p));
+        if let Some(k) = self.band(p[self.axis]) {
+            m[k] = m[k].merge(Moments::of(p, a, self.flat(p)));
+        }
     }
 }
 
@@ -544,18 +626,18 @@ fn check_up(
 /// Finds the canonical frame of `mesh` (a cleaned body), honouring `options`; a given unit or
 /// up axis that makes no standing person is refused with the likely fix.
 pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, FrameError> {
-    let bounds =
-        mesh.bounds().unwrap_or(crate::body::mesh::Aabb { min: DVec3::ZERO, max: DVec3::ZERO });
+    detect_surveyed(mesh, Survey::of(mesh), options)
+}
+
+/// [`detect`] with the [`Survey`] of `mesh` already taken (it must be `mesh`'s: see
+/// [`Surveyor`]); a stated up along another axis than the longest takes a pass for its bands.
+pub fn detect_surveyed(
+    mesh: &Mesh,
+    survey: Survey,
+    options: &FrameOptions,
+) -> Result<CanonicalFrame, FrameError> {
+    let Survey { bounds, moments: [all, rest @ ..] } = survey;
     let axis = bounds.size().max_position();
-    // One pass for the centroid and, for the longest axis either way up, the bands' moments;
-    // a stated up along another axis takes a second pass for its bands.
-    let along = |negative: bool| Bands::new(Direction { axis, negative }, &bounds);
-    let (up_axis, down_axis) = (along(false), along(true));
-    let [all, rest @ ..] = accumulate(mesh, |m: &mut [Moments; 7], p, a| {
-        m[0].add(p, a, DVec2::ZERO);
-        up_axis.add(&mut m[1..4], p, a);
-        down_axis.add(&mut m[4..7], p, a);
-    });
     let centroid = all.mean().unwrap_or(bounds.min);
     let detected_up =
         Direction { axis, negative: centroid[axis] < 0.5 * (bounds.min[axis] + bounds.max[axis]) };
@@ -590,7 +672,7 @@ pub fn detect(mesh: &Mesh, options: &FrameOptions) -> Result<CanonicalFrame, Fra
     let [trunk, feet, shins] = match (up.axis == axis, up.negative) {
         (true, false) => [rest[0], rest[1], rest[2]],
         (true, true) => [rest[3], rest[4], rest[5]],
-        (false, _) => accumulate(mesh, |m: &mut [Moments; 3], p, a| bands.add(m, p, a)),
+        (false, _) => merged(block_sums(mesh, |m: &mut [Moments; 3], p, a| bands.add(m, p, a))),
     };
     let flat = |p: DVec3| bands.flat(p);
     let centre = trunk.mean().unwrap_or(bounds.min);

@@ -19,7 +19,7 @@ use crate::messages;
 use carried::CarriedBody;
 use clean::{CleanError, CleaningReport};
 use format::{Format, MeshFile, ReadError};
-use frame::{CanonicalFrame, FrameError, FrameOptions};
+use frame::{CanonicalFrame, FileFrame, FrameError, FrameOptions};
 pub use prepare::{PreparedScan, ScanOptions, TopologyCheck, prepare, prepare_then};
 use std::path::{Path, PathBuf};
 
@@ -246,14 +246,7 @@ fn from_file(file: MeshFile, source: &Path, options: &FrameOptions) -> Result<Sc
     let mut scan = match carried {
         None => from_mesh(file.mesh, source, options)?,
         Some(carried) => {
-            let mut scan = cleaned_and_placed(file.mesh, source, |body| {
-                let frame = CanonicalFrame::stated(&carried.frame, body).map_err(|e| {
-                    let error = format!("header line '{}:': frame.{e}", carried::HEADER_KEY);
-                    ScanError::Header { path: source.into(), error }
-                })?;
-                body.transform(|p| frame.to_canonical(p));
-                Ok(frame)
-            })?;
+            let mut scan = cleaned_and_placed(file.mesh, source, Placing::Stated(&carried.frame))?;
             scan.carried = Some(carried);
             scan
         }
@@ -265,26 +258,43 @@ fn from_file(file: MeshFile, source: &Path, options: &FrameOptions) -> Result<Sc
 /// Cleans `mesh` (as a scanner delivered it) and moves it into the canonical frame; `source`
 /// names it in messages.
 pub fn from_mesh(mesh: Mesh, source: &Path, options: &FrameOptions) -> Result<Scan, ScanError> {
-    cleaned_and_placed(mesh, source, |body| {
-        let mut frame = frame::detect(body, options)
-            .map_err(|error| ScanError::Frame { path: source.into(), error })?;
-        body.transform(|p| frame.to_canonical(p));
-        frame.centre_on_torso(body);
-        Ok(frame)
-    })
+    cleaned_and_placed(mesh, source, Placing::Detected(options))
 }
 
-/// The one path of every scan: `mesh` cleaned, then moved into the canonical frame by `place`
-/// (which finds the frame, detected or stated, and moves the body into it).
-fn cleaned_and_placed(
-    mesh: Mesh,
-    source: &Path,
-    place: impl FnOnce(&mut Mesh) -> Result<CanonicalFrame, ScanError>,
-) -> Result<Scan, ScanError> {
+/// How a scan finds its canonical frame.
+enum Placing<'a> {
+    /// Detected (see [`frame::detect`]) with these options, then centred on the torso.
+    Detected(&'a FrameOptions),
+    /// As the file's header states it (a file dressform wrote).
+    Stated(&'a FileFrame),
+}
+
+/// The one path of every scan: `mesh` cleaned, then moved into the canonical frame, found as
+/// `placing` says. A detected frame's survey of the body is taken in the cleaning's pass over
+/// the triangles ([`clean::clean_surveyed`]) when the cleaning drops none.
+fn cleaned_and_placed(mesh: Mesh, source: &Path, placing: Placing) -> Result<Scan, ScanError> {
     let (raw_vertices, raw_triangles) = (mesh.positions.len(), mesh.triangles.len());
-    let (mut body, cleaning) =
-        clean::clean(mesh).map_err(|error| ScanError::Clean { path: source.into(), error })?;
-    let frame = place(&mut body)?;
+    let clean_error = |error| ScanError::Clean { path: source.into(), error };
+    let (body, cleaning, frame) = match placing {
+        Placing::Detected(options) => {
+            let (mut body, cleaning, survey) = clean::clean_surveyed(mesh).map_err(clean_error)?;
+            let survey = survey.unwrap_or_else(|| frame::Survey::of(&body));
+            let mut frame = frame::detect_surveyed(&body, survey, options)
+                .map_err(|error| ScanError::Frame { path: source.into(), error })?;
+            body.transform(|p| frame.to_canonical(p));
+            frame.centre_on_torso(&mut body);
+            (body, cleaning, frame)
+        }
+        Placing::Stated(stated) => {
+            let (mut body, cleaning) = clean::clean(mesh).map_err(clean_error)?;
+            let frame = CanonicalFrame::stated(stated, &body).map_err(|e| {
+                let error = format!("header line '{}:': frame.{e}", carried::HEADER_KEY);
+                ScanError::Header { path: source.into(), error }
+            })?;
+            body.transform(|p| frame.to_canonical(p));
+            (body, cleaning, frame)
+        }
+    };
     Ok(Scan {
         source: source.into(),
         raw_vertices,

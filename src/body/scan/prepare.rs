@@ -136,7 +136,7 @@ mod tests {
     use super::*;
     use crate::body::mesh::Mesh;
     use crate::body::mesh::shapes::add_tetrahedron;
-    use crate::body::scan::frame::{CanonicalFrame, FileFrame, Units};
+    use crate::body::scan::frame::{FileFrame, Units};
     use glam::DVec3;
 
     /// `mesh` as a scan, cleaned and in the frame of its own coordinates (mm, Z up).
@@ -146,10 +146,9 @@ mod tests {
             rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
             translation: [0.0; 3],
         };
-        super::super::cleaned_and_placed(mesh, Path::new("test.obj"), |body| {
-            Ok(CanonicalFrame::stated(&identity, body).expect("the identity is a frame"))
-        })
-        .expect("a tetrahedron cleans")
+        let stated = super::super::Placing::Stated(&identity);
+        super::super::cleaned_and_placed(mesh, Path::new("test.obj"), stated)
+            .expect("a tetrahedron cleans")
     }
 
     /// A tetrahedron: closed, smoothing moves its corners.
