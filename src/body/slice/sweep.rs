@@ -42,9 +42,11 @@ fn crossing_of(mesh: &Mesh, key: u64, h: f64) -> DVec2 {
     crossing(mesh, (key >> 32) as u32, key as u32, h)
 }
 
-/// The segment triangle `tri` leaves on the plane at `h` (it must cross it).
-fn segment(mesh: &Mesh, tri: [u32; 3], h: f64) -> Segment {
-    let above = tri.map(|v| mesh.positions[v as usize].z >= h);
+/// The segment triangle `tri` leaves on the plane at `h`, the `plane`th lowest (it must cross
+/// it); `below[v]` counts the planes at or below vertex `v`, so `v` is at or above `h` when
+/// that count exceeds `plane` (a smaller table than the positions to look up).
+fn segment(mesh: &Mesh, below: &[u32], plane: usize, tri: [u32; 3], h: f64) -> Segment {
+    let above = tri.map(|v| below[v as usize] as usize > plane);
     let (mut down, mut up) = ((0, 0), (0, 0));
     for k in 0..3 {
         let (a, b) = (tri[k], tri[(k + 1) % 3]);
@@ -99,7 +101,8 @@ pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
         .map(|k| {
             let h = planes.sorted[k];
             let mut segments: Vec<Segment> = Vec::with_capacity(crossings.count(k));
-            segments.extend(crossings.of(k).map(|t| segment(mesh, mesh.triangles[t as usize], h)));
+            let tri = |t: u32| mesh.triangles[t as usize];
+            segments.extend(crossings.of(k).map(|t| segment(mesh, &below, k, tri(t), h)));
             chain(&segments, h, |key| crossing_of(mesh, key, h))
         })
         .collect();
