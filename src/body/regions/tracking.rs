@@ -50,6 +50,27 @@ fn spans(body: &Mesh, tri: [u32; 3], below: f64, above: f64) -> bool {
     z[0].min(z[1]).min(z[2]) <= above && z[0].max(z[1]).max(z[2]) >= below
 }
 
+/// A few bits for each vertex of `body` from its height (`bits(z)`), in one pass over the
+/// positions in order: a pass over every triangle then tests its corners by three lookups in
+/// this table of a byte a vertex, not by three reads of scattered 24-byte positions.
+fn height_bits(body: &Mesh, bits: impl Fn(f64) -> u8 + Sync) -> Vec<u8> {
+    body.positions.par_iter().map(|p| bits(p.z)).collect()
+}
+
+/// The [`height_bits`] of triangle `tri`'s corners, or-ed.
+fn corner_bits(bits: &[u8], tri: [u32; 3]) -> u8 {
+    tri.iter().fold(0, |all, &v| all | bits[v as usize])
+}
+
+/// [`spans`] as [`height_bits`]: a triangle spans `below`..`above` when its corners' bits
+/// or-ed are both of these (a corner at or under `above`, and one at or over `below`).
+const SPAN_BITS: u8 = 0b11;
+
+/// A vertex's bits for [`SPAN_BITS`].
+fn span_bits(below: f64, above: f64) -> impl Fn(f64) -> u8 + Sync {
+    move |z| u8::from(z <= above) | u8::from(z >= below) << 1
+}
+
 /// The triangles of a body reaching a height or higher (a corner at or above it), in order:
 /// from the lower arm's join up, all that the armpits' bisections and the shoulders' searches
 /// look at, found in one pass over the body instead of one per search.
@@ -61,9 +82,8 @@ struct Reaching<'a> {
 impl<'a> Reaching<'a> {
     /// The triangles of `body` reaching `from`.
     fn new(body: &'a Mesh, from: f64) -> Reaching<'a> {
-        let reaches = |t: &u32| {
-            body.triangles[*t as usize].iter().any(|&v| body.positions[v as usize].z >= from)
-        };
+        let high = height_bits(body, |z| u8::from(z >= from));
+        let reaches = |t: &u32| corner_bits(&high, body.triangles[*t as usize]) != 0;
         let triangles = (0..body.triangles.len() as u32).into_par_iter().filter(reaches).collect();
         Reaching { body, triangles }
     }
@@ -82,7 +102,8 @@ impl<'a> Reaching<'a> {
 /// loop around both), by bisection to [`BISECTION_MM`], cutting only the part of the body
 /// between the two heights.
 fn refine_crotch(body: &Mesh, mut below: f64, mut above: f64, legs: [&Contour; 2]) -> f64 {
-    let near = body.part(|tri| spans(body, tri, below, above));
+    let bits = height_bits(body, span_bits(below, above));
+    let near = body.part(|tri| corner_bits(&bits, tri) == SPAN_BITS);
     while above - below > BISECTION_MM {
         let mid = 0.5 * (below + above);
         let s = &sections(&near, &[mid])[0];
