@@ -493,18 +493,17 @@ impl Surveyor {
     /// Adds a triangle (centroid `p`, area `a`) to `block`: to every triangle's moments, and
     /// to its band either way up (its own moments computed once for both).
     pub fn add(&self, block: &mut SurveyBlock, p: DVec3, a: f64) {
-        let along = p[self.up.axis];
-        let (up, down) = (self.up.band(along), self.down.band(along));
-        let own = Moments::of(p, a, self.up.flat(p));
         let m = &mut block.0;
         // Of every triangle's moments only the centroid is used.
-        m[0].weight += own.weight;
-        m[0].sum += own.sum;
-        if let Some(k) = up {
-            m[1 + k] = m[1 + k].merge(own);
-        }
-        if let Some(k) = down {
-            m[4 + k] = m[4 + k].merge(own);
+        m[0].weight += a;
+        m[0].sum += p * a;
+        let along = p[self.up.axis];
+        let bands = [self.up.band(along).map(|k| 1 + k), self.down.band(along).map(|k| 4 + k)];
+        if bands.iter().any(Option::is_some) {
+            let own = Moments::of(p, a, self.up.flat(p));
+            for k in bands.into_iter().flatten() {
+                m[k] = m[k].merge(own);
+            }
         }
     }
 
