@@ -1,10 +1,10 @@
 //! Cutting a mesh by many horizontal planes at once.
 //!
-//! Each triangle finds the planes it crosses by two binary searches in the sorted heights, so
-//! the work is proportional to the number of crossings, not triangles × planes. A triangle
-//! crossing plane `h` contributes one segment, from the point on its edge that runs down
-//! through `h` to the point on its edge that runs up; for an outward-oriented surface that
-//! makes outer loops counter-clockwise seen from above.
+//! Each vertex counts the planes at or below it, and a triangle crosses the planes between its
+//! corners' counts, so the work is proportional to the number of crossings, not triangles ×
+//! planes. A triangle crossing plane `h` contributes one segment, from the point on its edge
+//! that runs down through `h` to the point on its edge that runs up; for an outward-oriented
+//! surface that makes outer loops counter-clockwise seen from above.
 
 use super::{Contour, Section};
 use crate::body::mesh::Mesh;
@@ -95,15 +95,12 @@ pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
     let below: Vec<u32> =
         mesh.positions.par_iter().map(|p| planes.at_or_below(p.z) as u32).collect();
     let n = planes.sorted.len();
-    let crossings = Crossings::new(mesh, &below, n);
+    let crossings = Crossings::new(mesh, &below, &planes.sorted);
     let by_plane: Vec<Section> = (0..n)
         .into_par_iter()
         .map(|k| {
             let h = planes.sorted[k];
-            let mut segments: Vec<Segment> = Vec::with_capacity(crossings.count(k));
-            let tri = |t: u32| mesh.triangles[t as usize];
-            segments.extend(crossings.of(k).map(|t| segment(mesh, &below, k, tri(t), h)));
-            chain(&segments, h, |key| crossing_of(mesh, key, h))
+            chain(&crossings.of(k), h, |key| crossing_of(mesh, key, h))
         })
         .collect();
     let mut out: Vec<Section> = heights
@@ -120,35 +117,37 @@ pub fn sections(mesh: &Mesh, heights: &[f64]) -> Vec<Section> {
 /// that a plane's list is a handful of slices.
 const CROSSINGS_BLOCK: usize = 1 << 15;
 
-/// The triangles crossing each plane, in increasing order: a counting sort by plane within
-/// each block of [`CROSSINGS_BLOCK`] triangles, the blocks sorted in parallel (no serial pass
-/// over the crossings, and no list of them all before they are sorted); a plane's triangles
-/// are its slice of each block, blocks in order.
+/// Each plane's segments, in the order of their triangles: each block of [`CROSSINGS_BLOCK`]
+/// triangles cuts its triangles by every plane they cross and sorts the segments by plane
+/// (a counting sort; blocks in parallel), and a plane's segments are its slice of each block,
+/// blocks in order. A block's triangles, the `below` counts of their corners and their
+/// corners' positions are read while in cache (a scan's vertices lie near their triangles'
+/// order), where cutting plane by plane read them scattered over the whole mesh.
 struct Crossings {
     blocks: Vec<CrossingBlock>,
 }
 
-/// One block's triangles by plane: those of plane `k` are `triangles[offsets[k]..offsets[k + 1]]`.
+/// One block's segments by plane: those of plane `k` are `segments[offsets[k]..offsets[k + 1]]`.
 struct CrossingBlock {
     offsets: Vec<u32>,
-    triangles: Vec<u32>,
+    segments: Vec<Segment>,
 }
 
 impl Crossings {
-    /// The crossings of `planes` planes by the triangles of `mesh`, whose vertices have
-    /// `below[v]` planes at or below them: a triangle crosses the planes from its lowest
-    /// vertex's count up to (not including) its highest's.
-    fn new(mesh: &Mesh, below: &[u32], planes: usize) -> Crossings {
+    /// The segments of the triangles of `mesh` on the planes at `heights` (sorted), whose
+    /// vertices have `below[v]` planes at or below them: a triangle crosses the planes from
+    /// its lowest vertex's count up to (not including) its highest's.
+    fn new(mesh: &Mesh, below: &[u32], heights: &[f64]) -> Crossings {
+        let planes = heights.len();
         let blocks = mesh
             .triangles
             .par_chunks(CROSSINGS_BLOCK)
-            .enumerate()
-            .map(|(b, block)| {
-                let crossed: Vec<(u32, u32, u32)> = (block.iter().enumerate())
-                    .filter_map(|(i, tri)| {
+            .map(|block| {
+                let crossed: Vec<(u32, u32, [u32; 3])> = (block.iter())
+                    .filter_map(|&tri| {
                         let c = tri.map(|v| below[v as usize]);
                         let (first, end) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
-                        (first < end).then_some((first, end, (b * CROSSINGS_BLOCK + i) as u32))
+                        (first < end).then_some((first, end, tri))
                     })
                     .collect();
                 let mut offsets = vec![0u32; planes + 1];
@@ -161,30 +160,28 @@ impl Crossings {
                     offsets[k + 1] += offsets[k];
                 }
                 let mut fill = offsets.clone();
-                let mut triangles = vec![0u32; offsets[planes] as usize];
-                for &(first, end, t) in &crossed {
+                let none = Segment { from: 0, to: 0, start: DVec2::ZERO };
+                let mut segments = vec![none; offsets[planes] as usize];
+                for &(first, end, tri) in &crossed {
                     for k in first as usize..end as usize {
-                        triangles[fill[k] as usize] = t;
+                        segments[fill[k] as usize] = segment(mesh, below, k, tri, heights[k]);
                         fill[k] += 1;
                     }
                 }
-                CrossingBlock { offsets, triangles }
+                CrossingBlock { offsets, segments }
             })
             .collect();
         Crossings { blocks }
     }
 
-    /// How many triangles cross plane `k`.
-    fn count(&self, k: usize) -> usize {
-        self.blocks.iter().map(|b| (b.offsets[k + 1] - b.offsets[k]) as usize).sum()
-    }
-
-    /// The triangles crossing plane `k`, in increasing order.
-    fn of(&self, k: usize) -> impl Iterator<Item = u32> + '_ {
-        self.blocks
-            .iter()
-            .flat_map(move |b| b.triangles[b.offsets[k] as usize..b.offsets[k + 1] as usize].iter())
-            .copied()
+    /// The segments on plane `k`, in the order of their triangles.
+    fn of(&self, k: usize) -> Vec<Segment> {
+        let count = |b: &CrossingBlock| (b.offsets[k + 1] - b.offsets[k]) as usize;
+        let mut segments = Vec::with_capacity(self.blocks.iter().map(count).sum());
+        for b in &self.blocks {
+            segments.extend_from_slice(&b.segments[b.offsets[k] as usize..][..count(b)]);
+        }
+        segments
     }
 }
 
