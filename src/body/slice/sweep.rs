@@ -186,7 +186,7 @@ impl Crossings {
 }
 
 /// Sorted, finite plane heights, bucketed so that counting the planes at or below a height
-/// takes a table lookup and a search among one or two buckets' planes instead of all of them.
+/// takes a table lookup and a few comparisons with the planes near it instead of a search.
 struct Planes {
     sorted: Vec<f64>,
     lowest: f64,
@@ -194,8 +194,25 @@ struct Planes {
     /// plane, all at one height, or a span too wide or too narrow for f64), and then the
     /// search runs over all planes.
     scale: f64,
-    /// `first[b]`: the planes at or below the lower edge of bucket `b`.
-    first: Vec<usize>,
+    /// For a height in bucket `b` (the last entry: any bucket beyond), the planes it may lie
+    /// among: those of its bucket, widened by one bucket on each side against rounding.
+    near: Vec<Near>,
+}
+
+/// How many planes a [`Near`] compares without a search: a bucket is a quarter of the planes'
+/// mean spacing, so its widened range holds one plane or none, and more only where planes
+/// crowd together.
+const NEAR: usize = 3;
+
+/// The planes a height in one bucket may lie among: all planes before `from` lie below it, all
+/// from `to` on above it.
+#[derive(Clone, Copy)]
+struct Near {
+    from: usize,
+    to: usize,
+    /// The heights of planes `from..to`, then infinity, when there are at most [`NEAR`]: the
+    /// count at or below a height is then branch-free.
+    heights: Option<[f64; NEAR]>,
 }
 
 impl Planes {
@@ -207,10 +224,23 @@ impl Planes {
         let buckets = 4 * sorted.len().min(1 << 14);
         let scale = buckets as f64 / (highest - lowest);
         let scale = if highest > lowest && scale.is_finite() { scale } else { 0.0 };
-        let first = (0..=buckets)
+        // `first[b]`: the planes at or below the lower edge of bucket `b`.
+        let first: Vec<usize> = (0..=buckets)
             .map(|b| sorted.partition_point(|&h| (h - lowest) * scale <= b as f64))
             .collect();
-        Planes { sorted, lowest, scale, first }
+        let near = (0..=buckets + 1)
+            .map(|b| {
+                let (from, to) =
+                    (first[b.saturating_sub(1).min(buckets)], first[(b + 2).min(buckets)]);
+                let heights = (to - from <= NEAR).then(|| {
+                    let mut heights = [f64::INFINITY; NEAR];
+                    heights[..to - from].copy_from_slice(&sorted[from..to]);
+                    heights
+                });
+                Near { from, to, heights }
+            })
+            .collect();
+        Planes { sorted, lowest, scale, near }
     }
 
     /// How many planes lie at or below `z` (none below a NaN).
@@ -225,14 +255,13 @@ impl Planes {
         if self.scale == 0.0 {
             return self.sorted.partition_point(|&h| h <= z);
         }
-        // The bucket of `z`, widened by one on each side against rounding.
         let b = ((z - self.lowest) * self.scale) as usize;
-        let buckets = self.first.len() - 1;
-        let (from, to) = (
-            self.first[b.saturating_sub(1).min(buckets)],
-            self.first[b.saturating_add(2).min(buckets)],
-        );
-        from + self.sorted[from..to].partition_point(|&h| h <= z)
+        let near = &self.near[b.min(self.near.len() - 1)];
+        near.from
+            + match &near.heights {
+                Some(heights) => heights.iter().map(|&h| usize::from(h <= z)).sum(),
+                None => self.sorted[near.from..near.to].partition_point(|&h| h <= z),
+            }
     }
 }
 
@@ -501,6 +530,23 @@ mod tests {
         // A span too narrow to divide into buckets (subnormal numbers).
         let s = sections(&mesh, &[5e-310, 6e-310, 7e-310]);
         assert!(s.iter().all(|sec| sec.loops.len() == 1 && sec.loops[0].points.len() == 128));
+    }
+
+    #[test]
+    fn planes_at_or_below_a_height_are_counted_exactly_where_they_crowd() {
+        // Twelve planes within a bucket's width, others spread out, one repeated: every
+        // height, on a plane or between, counts as a search over all planes counts.
+        let mut sorted: Vec<f64> = (0..12).map(|i| 50.0 + 0.01 * i as f64).collect();
+        sorted.extend([0.0, 10.0, 10.0, 33.3, 80.0, 100.0]);
+        sorted.sort_by(f64::total_cmp);
+        let planes = Planes::new(sorted.clone());
+        let mut heights: Vec<f64> = (-10..=1100).map(|i| 0.1 * i as f64).collect();
+        heights.extend(sorted.iter().flat_map(|&h| [h, h.next_down(), h.next_up()]));
+        for z in heights {
+            let searched = sorted.partition_point(|&h| h <= z);
+            assert_eq!(planes.at_or_below(z), searched, "at z = {z}");
+        }
+        assert_eq!(planes.at_or_below(f64::NAN), 0);
     }
 
     #[test]
