@@ -296,19 +296,20 @@ impl BodyRegions {
                 let i = ((z - levels[0].section.height) / step).round();
                 &levels[(i.max(0.0) as usize).min(levels.len() - 1)]
             });
+        let tracked = &level.section.loops;
+        // A hole (clockwise: thighs touching below the crotch enclose one) is no part of its
+        // own, and holds no loop.
+        let outlines: Vec<bool> = tracked.iter().map(|l| l.signed_area() > 0.0).collect();
         section
             .loops
             .iter()
             .map(|l| {
                 let c = l.centroid();
-                let tracked = &level.section.loops;
                 // The innermost outline holding it: a hand pressed into the hip or thigh may
                 // cross the skin there (a posed mesh's blend skinning does), its loop then
-                // lying inside the torso's. A hole (clockwise: thighs touching below the
-                // crotch enclose one) is no part of its own and is passed over.
-                let inside = (0..tracked.len())
-                    .rev()
-                    .find(|&k| tracked[k].signed_area() > 0.0 && tracked[k].contains(c));
+                // lying inside the torso's.
+                let inside =
+                    (0..tracked.len()).rev().find(|&k| outlines[k] && tracked[k].contains(c));
                 let nearest = || {
                     (0..tracked.len()).min_by(|&a, &b| {
                         let da = tracked[a].centroid().distance_squared(c);

@@ -60,12 +60,16 @@ impl Contour {
 
     /// Centroid of the enclosed region (falls back to the mean point for a zero-area loop).
     pub fn centroid(&self) -> DVec2 {
-        let area = self.signed_area();
+        // The shoelace sums of the area and of the first moments, in one pass over the edges.
+        let (twice_area, sum) = self.edges().fold((0.0, DVec2::ZERO), |(area, sum), (a, b)| {
+            let cross = a.perp_dot(b);
+            (area + cross, sum + (a + b) * cross)
+        });
+        let area = 0.5 * twice_area;
         if area.abs() < f64::EPSILON {
             let n = self.points.len().max(1) as f64;
             return self.points.iter().copied().sum::<DVec2>() / n;
         }
-        let sum: DVec2 = self.edges().map(|(a, b)| (a + b) * a.perp_dot(b)).sum();
         sum / (6.0 * area)
     }
 
