@@ -194,18 +194,19 @@ struct Planes {
     /// plane, all at one height, or a span too wide or too narrow for f64), and then the
     /// search runs over all planes.
     scale: f64,
-    /// For a height in bucket `b` (the last entry: any bucket beyond), the planes it may lie
-    /// among: those of its bucket, widened by one bucket on each side against rounding.
+    /// For a height in bucket `b` (entry `b`, the top edge's bucket included; the last entry:
+    /// a height rounded past it), the planes it may lie among: those of its bucket, widened by
+    /// one bucket on each side against rounding.
     near: Vec<Near>,
 }
 
-/// How many planes a [`Near`] compares without a search: a bucket is a quarter of the planes'
-/// mean spacing, so its widened range holds one plane or none, and more only where planes
-/// crowd together.
+/// How many planes a [`Near`] compares without a search: up to 16,384 planes a bucket is a
+/// quarter of their mean spacing, so its widened range holds one plane or none, and more only
+/// where planes crowd together.
 const NEAR: usize = 3;
 
-/// The planes a height in one bucket may lie among: all planes before `from` lie below it, all
-/// from `to` on above it.
+/// The planes a height in one bucket may lie among: all planes before `from` lie at or below
+/// it, all from `to` on above it.
 #[derive(Clone, Copy)]
 struct Near {
     from: usize,
